@@ -7,5 +7,6 @@
 #![forbid(unsafe_code)]
 
 pub mod color;
-pub mod math;
 pub mod image;
+pub mod math;
+pub mod render;

@@ -29,7 +29,11 @@ impl Frame {
         if s == Vec3::ZERO {
             return Frame::from_normal(n);
         }
-        Frame { s, t: n.cross(s), n }
+        Frame {
+            s,
+            t: n.cross(s),
+            n,
+        }
     }
 
     pub fn to_local(&self, v: Vec3) -> Vec3 {
@@ -57,7 +61,9 @@ mod tests {
             let f = Frame::from_normal(n);
             assert!((f.s.length() - 1.0).abs() < 1e-5);
             assert!((f.t.length() - 1.0).abs() < 1e-5);
-            assert!(f.s.dot(f.t).abs() < 1e-5 && f.s.dot(n).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5);
+            assert!(
+                f.s.dot(f.t).abs() < 1e-5 && f.s.dot(n).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5
+            );
             let v = Vec3::new(0.2, 0.7, -0.4);
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);
         }

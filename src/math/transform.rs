@@ -54,7 +54,10 @@ impl Transform {
             return None;
         }
         let m = Mat4::from_axis_angle(axis, degrees.to_radians());
-        Some(Transform { m, inv: m.transpose() })
+        Some(Transform {
+            m,
+            inv: m.transpose(),
+        })
     }
 
     /// pbrt's `LookAt`: the camera-from-world transform for a camera at `eye` looking at

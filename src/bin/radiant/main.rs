@@ -3,7 +3,11 @@
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "radiant", version, about = "A physically based global-illumination renderer")]
+#[command(
+    name = "radiant",
+    version,
+    about = "A physically based global-illumination renderer"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
