@@ -10,3 +10,4 @@ pub mod color;
 pub mod image;
 pub mod math;
 pub mod render;
+pub mod scene;

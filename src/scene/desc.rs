@@ -1,0 +1,261 @@
+//! The scene description: plain data produced by the pbrt parser or by the canonical
+//! scenes in code, and consumed by `render` and `radiosity`.
+//!
+//! Geometry is kept in object space with its `render_from_object` transform (render
+//! space = pbrt's world space). Radiometric values are final: light `scale` and `power`
+//! have already been folded into `L` / `I`.
+
+use std::path::PathBuf;
+
+use glam::{Vec2, Vec3};
+
+use super::error::{FileLoc, Warning};
+use super::params::ParamSet;
+use crate::color::Rgb;
+use crate::math::Transform;
+
+/// Everything needed to render one image.
+#[derive(Clone, Debug)]
+pub struct SceneDesc {
+    pub camera: CameraDesc,
+    pub film: FilmDesc,
+    pub sampler: SamplerDesc,
+    pub filter: FilterDesc,
+    pub integrator: IntegratorDesc,
+    pub materials: Vec<MaterialDesc>,
+    pub shapes: Vec<ShapeDesc>,
+    /// Object prototypes (`ObjectBegin`); their shapes are in instance space.
+    pub objects: Vec<ObjectDesc>,
+    pub instances: Vec<InstanceDesc>,
+    pub lights: Vec<LightDesc>,
+    /// Everything read but not supported, and parameters never used.
+    pub warnings: Vec<Warning>,
+    /// The scene file, when the scene came from one (relative paths resolve from its folder).
+    pub source: Option<PathBuf>,
+}
+
+/// `Camera`: where it is and how it forms the image.
+#[derive(Clone, Debug)]
+pub struct CameraDesc {
+    /// The current transform at the `Camera` directive.
+    pub camera_from_world: Transform,
+    pub kind: CameraKind,
+    pub loc: FileLoc,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum CameraKind {
+    /// `"perspective"`: `fov` (degrees, spans the shorter image axis), thin-lens depth of
+    /// field from `lensradius` and `focaldistance`; `screenwindow` overrides the window.
+    Perspective {
+        fov_deg: f32,
+        lens_radius: f32,
+        focal_distance: f32,
+        screen_window: Option<[f32; 4]>,
+    },
+    /// `"orthographic"`: parallel projection through `screenwindow` (default [-1,1] on the
+    /// shorter axis).
+    Orthographic {
+        lens_radius: f32,
+        focal_distance: f32,
+        screen_window: Option<[f32; 4]>,
+    },
+    /// `"realistic"`: rays through a lens prescription (Kolb, Mitchell & Hanrahan 1995).
+    /// `lens_file` is already resolved against the scene file's folder.
+    Realistic {
+        lens_file: PathBuf,
+        aperture_diameter_mm: f32,
+        focus_distance: f32,
+    },
+}
+
+/// `Film "rgb"`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilmDesc {
+    pub xresolution: u32,
+    pub yresolution: u32,
+    /// Output name from the file; the CLI's `-o` overrides it.
+    pub filename: Option<String>,
+    /// Film diagonal in mm (used by the realistic camera); pbrt default 35.
+    pub diagonal_mm: f32,
+    /// Sensor sensitivity; pbrt-v4 scales the image by `iso / 100` for the realistic
+    /// camera's physical exposure. Default 100.
+    pub iso: f32,
+    pub loc: FileLoc,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplerKind {
+    /// Owen-scrambled Sobol (any low-discrepancy pbrt sampler maps here).
+    Sobol,
+    /// Independent uniform random numbers.
+    Independent,
+}
+
+/// `Sampler`: kind, samples per pixel and seed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SamplerDesc {
+    pub kind: SamplerKind,
+    pub pixel_samples: u32,
+    pub seed: u64,
+    pub loc: FileLoc,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FilterKind {
+    Box,
+    Triangle,
+    /// pbrt-v4's truncated Gaussian with standard deviation `sigma` (pixels).
+    Gaussian {
+        sigma: f32,
+    },
+}
+
+/// `PixelFilter`: kind and radius in pixels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilterDesc {
+    pub kind: FilterKind,
+    pub radius: Vec2,
+    pub loc: FileLoc,
+}
+
+/// `Integrator`: the name and its parameters, which the chosen integrator reads (and
+/// whose unused entries it reports) when the render is set up.
+#[derive(Clone, Debug)]
+pub struct IntegratorDesc {
+    pub name: String,
+    pub params: ParamSet,
+    pub loc: FileLoc,
+}
+
+/// Index into `SceneDesc::materials`.
+pub type MaterialId = u32;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum MaterialDesc {
+    /// Lambertian reflector, `reflectance` in [0,1] per channel.
+    Diffuse { reflectance: Rgb },
+    /// Smooth dielectric interface with relative index `eta` (inside / outside).
+    Dielectric { eta: f32 },
+    /// Smooth conductor: a perfect mirror with the given reflectance, or Fresnel
+    /// reflection from complex index `eta + i k` per channel.
+    Conductor(ConductorDesc),
+    /// `"interface"`: no surface at all (a boundary between media); rays pass through.
+    Interface,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ConductorDesc {
+    Reflectance(Rgb),
+    EtaK { eta: Rgb, k: Rgb },
+}
+
+/// A diffuse area light attached to a shape (`AreaLightSource "diffuse"`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AreaLightDesc {
+    /// Emitted radiance, `scale` (and `power`) already applied.
+    pub l: Rgb,
+    /// Emits on both sides; otherwise only on the side of the surface normal.
+    pub two_sided: bool,
+}
+
+/// Shape geometry in object space.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Geometry {
+    /// Triangles: three indices each into `positions`. Optional per-vertex shading
+    /// normals and uvs (same length as `positions`).
+    TriangleMesh {
+        positions: Vec<Vec3>,
+        indices: Vec<u32>,
+        normals: Option<Vec<Vec3>>,
+        uvs: Option<Vec<Vec2>>,
+    },
+    /// Bilinear patches: four indices each, in pbrt's order (p00, p10, p01, p11).
+    BilinearMesh {
+        positions: Vec<Vec3>,
+        indices: Vec<u32>,
+        normals: Option<Vec<Vec3>>,
+        uvs: Option<Vec<Vec2>>,
+    },
+    /// Sphere about the object-space origin (pbrt: `radius`, `zmin`, `zmax`, `phimax` degrees).
+    Sphere {
+        radius: f32,
+        z_min: f32,
+        z_max: f32,
+        phi_max_deg: f32,
+    },
+    /// Disk in the plane z = `height`, normal +z.
+    Disk {
+        height: f32,
+        radius: f32,
+        inner_radius: f32,
+        phi_max_deg: f32,
+    },
+}
+
+/// One `Shape` with the graphics state that applied to it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShapeDesc {
+    pub geometry: Geometry,
+    pub render_from_object: Transform,
+    /// `ReverseOrientation` was in effect (flips the normal, and so the emitting side).
+    pub reverse_orientation: bool,
+    pub material: MaterialId,
+    pub area_light: Option<AreaLightDesc>,
+    pub loc: FileLoc,
+}
+
+/// `ObjectBegin "name"` … `ObjectEnd`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectDesc {
+    pub name: String,
+    pub shapes: Vec<ShapeDesc>,
+    pub loc: FileLoc,
+}
+
+/// `ObjectInstance "name"` with the transform in effect.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InstanceDesc {
+    /// Index into `SceneDesc::objects`.
+    pub object: usize,
+    pub render_from_instance: Transform,
+    pub loc: FileLoc,
+}
+
+/// `LightSource`. Positions and directions are in render space; `scale` and `power`
+/// are already applied.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LightDesc {
+    /// Isotropic point light with radiant intensity `intensity` (W/sr per channel).
+    Point {
+        position: Vec3,
+        intensity: Rgb,
+        loc: FileLoc,
+    },
+    /// Spot light at `position` aimed along unit `direction`; full intensity inside
+    /// `cos_falloff_start`, smoothly falling to zero at `cos_total_width` (pbrt-v4).
+    Spot {
+        position: Vec3,
+        direction: Vec3,
+        intensity: Rgb,
+        cos_falloff_start: f32,
+        cos_total_width: f32,
+        loc: FileLoc,
+    },
+    /// Directional light: radiance arrives travelling along unit `direction`
+    /// (from `from` towards `to`), irradiance `radiance` on a perpendicular surface.
+    Distant {
+        direction: Vec3,
+        radiance: Rgb,
+        loc: FileLoc,
+    },
+    /// Constant environment radiance from every direction.
+    Infinite { radiance: Rgb, loc: FileLoc },
+}
+
+impl SceneDesc {
+    /// The file name to write: the film's, or a default.
+    pub fn output_name(&self) -> &str {
+        self.film.filename.as_deref().unwrap_or("radiant.exr")
+    }
+}

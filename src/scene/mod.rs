@@ -1,0 +1,12 @@
+//! Scene input: the pbrt-v4 tokenizer and parser, mesh readers (PLY, OBJ), and the
+//! canonical scenes built in code. Everything ends in a [`SceneDesc`]: plain data that
+//! the renderer and the radiosity solver read.
+
+pub mod builtin;
+pub mod desc;
+pub mod error;
+pub mod params;
+
+pub use desc::*;
+pub use error::{FileLoc, SceneError, Warning};
+pub use params::{Param, ParamSet, ParamValue};
