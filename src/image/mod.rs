@@ -1,6 +1,8 @@
 //! Images and files: the film that integrators accumulate into, pixel filters, the
 //! EXR / PFM / PNG writers and readers, and the error metrics used to compare renders.
 
+pub mod film;
+
 use crate::color::Rgb;
 
 /// A linear RGB image, row-major, row 0 at the top (pixel (0,0) is top-left).
