@@ -48,12 +48,16 @@ pub struct RayBenchFigures {
     pub camera_rays: usize,
     pub camera_hit_fraction: f64,
     pub camera_mrays_per_s: f64,
+    /// Rays per CPU-second of tracing (per-core speed; `None` where unmeasured).
+    pub camera_mrays_per_cpu_s: Option<f64>,
     pub diffuse_rays: usize,
     pub diffuse_hit_fraction: f64,
     pub diffuse_mrays_per_s: f64,
+    pub diffuse_mrays_per_cpu_s: Option<f64>,
     pub shadow_rays: usize,
     pub shadow_occluded_fraction: f64,
     pub shadow_mrays_per_s: f64,
+    pub shadow_mrays_per_cpu_s: Option<f64>,
 }
 
 impl fmt::Display for RayBenchFigures {
@@ -63,27 +67,45 @@ impl fmt::Display for RayBenchFigures {
             "scene: {} triangles; BVH build {:.3} s ({} nodes, {} 4-triangle blocks); {} threads",
             self.triangles, self.build_seconds, self.nodes, self.blocks, self.threads
         )?;
-        writeln!(
-            f,
-            "camera  rays: {:>8} ({:5.1}% hit)       {:6.2} Mrays/s",
-            self.camera_rays,
-            100.0 * self.camera_hit_fraction,
-            self.camera_mrays_per_s
-        )?;
-        writeln!(
-            f,
-            "diffuse rays: {:>8} ({:5.1}% hit)       {:6.2} Mrays/s",
-            self.diffuse_rays,
-            100.0 * self.diffuse_hit_fraction,
-            self.diffuse_mrays_per_s
-        )?;
-        write!(
-            f,
-            "shadow  rays: {:>8} ({:5.1}% occluded)  {:6.2} Mrays/s",
-            self.shadow_rays,
-            100.0 * self.shadow_occluded_fraction,
-            self.shadow_mrays_per_s
-        )
+        let per_cpu = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.2}"));
+        let rows = [
+            (
+                "camera ",
+                self.camera_rays,
+                self.camera_hit_fraction,
+                "hit",
+                self.camera_mrays_per_s,
+                self.camera_mrays_per_cpu_s,
+            ),
+            (
+                "diffuse",
+                self.diffuse_rays,
+                self.diffuse_hit_fraction,
+                "hit",
+                self.diffuse_mrays_per_s,
+                self.diffuse_mrays_per_cpu_s,
+            ),
+            (
+                "shadow ",
+                self.shadow_rays,
+                self.shadow_occluded_fraction,
+                "occluded",
+                self.shadow_mrays_per_s,
+                self.shadow_mrays_per_cpu_s,
+            ),
+        ];
+        for (i, (name, n, frac, what, wall, cpu)) in rows.into_iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            write!(
+                f,
+                "{name} rays: {n:>8} ({:5.1}% {what:<8}) {wall:6.2} Mrays/s  ({} Mrays per CPU-second)",
+                100.0 * frac,
+                per_cpu(cpu)
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -113,25 +135,62 @@ fn uniform2(seed: u64, index: u64, dim: u64) -> Vec2 {
     Vec2::new(u32_to_unit_f32(h as u32), u32_to_unit_f32((h >> 32) as u32))
 }
 
+/// CPU time consumed so far by the calling thread, in seconds (Linux: the first field of
+/// /proc/thread-self/schedstat, in ns). `None` where unavailable.
+fn thread_cpu_seconds() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: u64 = text.split_whitespace().next()?.parse().ok()?;
+    Some(ns as f64 * 1e-9)
+}
+
+/// Wall and CPU seconds of one traced batch.
+#[derive(Clone, Copy)]
+struct Timing {
+    wall: f64,
+    cpu: Option<f64>,
+}
+
 /// Traces `rays` with `trace` on all threads, `repetitions` times; returns the results of
-/// the last run and the best time in seconds.
+/// the last run and the fastest run's timing. CPU time is summed over the worker threads,
+/// so rays per CPU-second measures per-core speed even on a machine shared with others.
 fn timed<T: Send + Copy + Default>(
     rays: &[(Ray, f32)],
     repetitions: u32,
     trace: impl Fn(&Ray, f32) -> T + Sync,
-) -> (Vec<T>, f64) {
+) -> (Vec<T>, Timing) {
     let mut out = vec![T::default(); rays.len()];
-    let mut best = f64::INFINITY;
+    let mut best = Timing {
+        wall: f64::INFINITY,
+        cpu: None,
+    };
     for _ in 0..repetitions.max(1) {
+        let cpu_ns = std::sync::atomic::AtomicU64::new(0);
+        let cpu_ok = std::sync::atomic::AtomicBool::new(true);
         let start = Instant::now();
         out.par_chunks_mut(1024)
             .zip(rays.par_chunks(1024))
             .for_each(|(o, r)| {
+                let before = thread_cpu_seconds();
                 for (slot, (ray, t_max)) in o.iter_mut().zip(r) {
                     *slot = trace(ray, *t_max);
                 }
+                match (before, thread_cpu_seconds()) {
+                    (Some(b), Some(a)) => {
+                        let ns = ((a - b) * 1e9) as u64;
+                        cpu_ns.fetch_add(ns, std::sync::atomic::Ordering::Relaxed);
+                    }
+                    _ => cpu_ok.store(false, std::sync::atomic::Ordering::Relaxed),
+                }
             });
-        best = best.min(start.elapsed().as_secs_f64());
+        let wall = start.elapsed().as_secs_f64();
+        let cpu = cpu_ok
+            .into_inner()
+            .then(|| cpu_ns.into_inner() as f64 * 1e-9);
+        best.wall = best.wall.min(wall);
+        best.cpu = match (best.cpu, cpu) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
     }
     (out, best)
 }
@@ -212,12 +271,15 @@ pub fn ray_benchmark(config: &RayBenchConfig) -> RayBenchFigures {
         blocks,
         camera_rays: cam.len(),
         camera_hit_fraction: frac(surface.len(), cam.len()),
-        camera_mrays_per_s: cam.len() as f64 / cam_time / 1e6,
+        camera_mrays_per_s: cam.len() as f64 / cam_time.wall / 1e6,
+        camera_mrays_per_cpu_s: cam_time.cpu.map(|c| cam.len() as f64 / c / 1e6),
         diffuse_rays: diffuse.len(),
         diffuse_hit_fraction: frac(count(&diffuse_hits), diffuse.len()),
-        diffuse_mrays_per_s: diffuse.len() as f64 / diffuse_time / 1e6,
+        diffuse_mrays_per_s: diffuse.len() as f64 / diffuse_time.wall / 1e6,
+        diffuse_mrays_per_cpu_s: diffuse_time.cpu.map(|c| diffuse.len() as f64 / c / 1e6),
         shadow_rays: shadow.len(),
         shadow_occluded_fraction: frac(count(&occluded), shadow.len()),
-        shadow_mrays_per_s: shadow.len() as f64 / shadow_time / 1e6,
+        shadow_mrays_per_s: shadow.len() as f64 / shadow_time.wall / 1e6,
+        shadow_mrays_per_cpu_s: shadow_time.cpu.map(|c| shadow.len() as f64 / c / 1e6),
     }
 }
