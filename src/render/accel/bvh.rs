@@ -1,0 +1,115 @@
+//! The generic BVH: any primitive behind a closure. This is the two-level entry point too:
+//! a primitive may be an instance whose closure transforms the ray and traverses another
+//! `Bvh` or `TriangleBvh` (see the instancing test below).
+
+use super::build::{BuildSettings, build_binary, collapse};
+use super::node::{Node4, NodeRay, decode_leaf, encode_leaf};
+use super::traverse;
+use crate::render::geometry::{Aabb, Ray};
+
+/// A 4-wide BVH over caller-owned primitives given by their bounding boxes.
+#[derive(Clone, Debug, Default)]
+pub struct Bvh {
+    nodes: Vec<Node4>,
+    order: Vec<u32>,
+    bounds: Aabb,
+}
+
+/// Leaves of up to 4 primitives; a node visit costs about as much as one intersection
+/// of a generic primitive (instances and analytic shapes cost more, which favours small leaves).
+const SETTINGS: BuildSettings = BuildSettings {
+    leaf_block: 1,
+    max_leaf: 4,
+    cost_traversal: 1.0,
+};
+
+impl Bvh {
+    /// Binned SAH build (Wald 2007), parallel with rayon for large inputs, collapsed to a
+    /// 4-wide node array flattened depth-first. Primitives whose box is empty or not
+    /// finite can never be hit and are left out.
+    pub fn build(prim_bounds: &[Aabb]) -> Bvh {
+        let (root, order) = build_binary(prim_bounds, &SETTINGS);
+        let Some(root) = root else {
+            return Bvh::default();
+        };
+        let nodes = collapse(&root, &mut encode_leaf);
+        let bounds = order
+            .iter()
+            .fold(Aabb::EMPTY, |b, &i| b.union(&prim_bounds[i as usize]));
+        Bvh {
+            nodes,
+            order,
+            bounds,
+        }
+    }
+
+    /// Closest hit in (0, t_max): calls `intersect_prim(prim_index, t_max)` for candidate
+    /// primitives, nearest subtrees first; the closure returns `Some(t)` for a hit closer
+    /// than the `t_max` it was given (and records whatever it needs), and the traversal
+    /// shrinks `t_max` to it. Returns the closest `t`.
+    #[inline]
+    pub fn closest_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut intersect_prim: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Option<f32> {
+        let mut found = false;
+        let t = traverse::closest(&self.nodes, &NodeRay::new(ray), t_max, |leaf, t_max| {
+            let (start, count) = decode_leaf(leaf);
+            let mut t_max = t_max;
+            let mut hit = false;
+            for &prim in &self.order[start..start + count] {
+                if let Some(t) = intersect_prim(prim, t_max).filter(|&t| t < t_max) {
+                    t_max = t;
+                    hit = true;
+                }
+            }
+            found |= hit;
+            hit.then_some(t_max)
+        });
+        found.then_some(t)
+    }
+
+    /// Any hit in (0, t_max): stops at the first primitive for which
+    /// `occludes(prim_index, t_max)` returns true.
+    #[inline]
+    pub fn any_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut occludes: impl FnMut(u32, f32) -> bool,
+    ) -> bool {
+        traverse::any(&self.nodes, &NodeRay::new(ray), t_max, |leaf, t_max| {
+            let (start, count) = decode_leaf(leaf);
+            self.order[start..start + count]
+                .iter()
+                .any(|&prim| occludes(prim, t_max))
+        })
+    }
+
+    /// The primitive indices in leaf order: `prim_order()[k]` is the primitive in the k-th
+    /// leaf slot. A caller may permute its arrays into this order for locality and then
+    /// call [`Bvh::renumber_in_leaf_order`].
+    pub fn prim_order(&self) -> &[u32] {
+        &self.order
+    }
+
+    /// After the caller has permuted its primitive arrays by `prim_order()` (new index k
+    /// holds old primitive `prim_order()[k]`), makes the closures receive the new indices.
+    pub fn renumber_in_leaf_order(&mut self) {
+        for (k, p) in self.order.iter_mut().enumerate() {
+            *p = k as u32;
+        }
+    }
+
+    /// Bounds of all primitives in the tree.
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// Number of 4-wide nodes (for statistics).
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+}

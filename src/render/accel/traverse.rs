@@ -1,0 +1,155 @@
+//! Stack-based traversal of the 4-wide node array, shared by the generic and the
+//! triangle BVH. Leaves are handed to a closure; the closures are monomorphised and
+//! inlined, so the triangle path pays no indirection.
+//!
+//! Closest-hit traversal is ordered: of the children a ray enters, the nearest (by entry
+//! distance) is visited next and the others are pushed far-to-near, each with its entry
+//! distance so that it is skipped when popped if a closer hit has been found since.
+
+use super::build::MAX_DEPTH;
+use super::node::{LEAF_BIT, Node4, NodeRay};
+
+/// Each 4-wide level pushes at most three siblings and there are at most `MAX_DEPTH`
+/// levels, so this bounds the stack.
+const STACK_SIZE: usize = 3 * MAX_DEPTH as usize + 4;
+
+#[derive(Clone, Copy, Default)]
+struct Entry {
+    node: u32,
+    t_in: f32,
+}
+
+/// Visits the leaves that may hold a hit closer than `t_max`, nearest first.
+/// `leaf(reference, t_max)` returns the new, smaller `t_max` when it found a hit.
+/// Returns the final `t_max`.
+#[inline(always)]
+pub(crate) fn closest(
+    nodes: &[Node4],
+    ray: &NodeRay,
+    mut t_max: f32,
+    mut leaf: impl FnMut(u32, f32) -> Option<f32>,
+) -> f32 {
+    if nodes.is_empty() {
+        return t_max;
+    }
+    let mut stack = [Entry::default(); STACK_SIZE];
+    let mut sp = 0usize;
+    let mut cur = 0u32;
+    loop {
+        if cur & LEAF_BIT == 0 {
+            let node = &nodes[cur as usize];
+            let (mut mask, t_in) = ray.hit(node, t_max);
+            if mask != 0 {
+                let t_in = t_in.to_array();
+                let i0 = mask.trailing_zeros() as usize & 3;
+                mask &= mask - 1;
+                if mask == 0 {
+                    cur = node.child[i0];
+                    continue;
+                }
+                let i1 = mask.trailing_zeros() as usize & 3;
+                mask &= mask - 1;
+                if mask == 0 {
+                    let (near, far) = if t_in[i0] <= t_in[i1] {
+                        (i0, i1)
+                    } else {
+                        (i1, i0)
+                    };
+                    stack[sp] = Entry {
+                        node: node.child[far],
+                        t_in: t_in[far],
+                    };
+                    sp += 1;
+                    cur = node.child[near];
+                    continue;
+                }
+                // Three or four children: sort by entry distance (insertion sort).
+                let mut c = [Entry::default(); 4];
+                c[0] = Entry {
+                    node: node.child[i0],
+                    t_in: t_in[i0],
+                };
+                c[1] = Entry {
+                    node: node.child[i1],
+                    t_in: t_in[i1],
+                };
+                let mut k = 2;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize & 3;
+                    mask &= mask - 1;
+                    c[k & 3] = Entry {
+                        node: node.child[i],
+                        t_in: t_in[i],
+                    };
+                    k += 1;
+                }
+                for i in 1..k.min(4) {
+                    let mut j = i;
+                    while j > 0 && c[j - 1].t_in > c[j].t_in {
+                        c.swap(j - 1, j);
+                        j -= 1;
+                    }
+                }
+                for e in c[1..k.min(4)].iter().rev() {
+                    stack[sp] = *e;
+                    sp += 1;
+                }
+                cur = c[0].node;
+                continue;
+            }
+        } else if let Some(t) = leaf(cur, t_max) {
+            t_max = t;
+        }
+        // Pop the nearest pending subtree that can still hold a closer hit.
+        loop {
+            if sp == 0 {
+                return t_max;
+            }
+            sp -= 1;
+            let e = stack[sp];
+            if e.t_in <= t_max {
+                cur = e.node;
+                break;
+            }
+        }
+    }
+}
+
+/// Visits leaves until `leaf(reference, t_max)` reports an occluder; returns whether one did.
+#[inline(always)]
+pub(crate) fn any(
+    nodes: &[Node4],
+    ray: &NodeRay,
+    t_max: f32,
+    mut leaf: impl FnMut(u32, f32) -> bool,
+) -> bool {
+    if nodes.is_empty() {
+        return false;
+    }
+    let mut stack = [0u32; STACK_SIZE];
+    let mut sp = 0usize;
+    let mut cur = 0u32;
+    loop {
+        if cur & LEAF_BIT == 0 {
+            let node = &nodes[cur as usize];
+            let (mut mask, _) = ray.hit(node, t_max);
+            if mask != 0 {
+                cur = node.child[mask.trailing_zeros() as usize & 3];
+                mask &= mask - 1;
+                while mask != 0 {
+                    stack[sp] = node.child[mask.trailing_zeros() as usize & 3];
+                    sp += 1;
+                    mask &= mask - 1;
+                }
+                continue;
+            }
+        } else if leaf(cur, t_max) {
+            return true;
+        }
+        if sp == 0 {
+            return false;
+        }
+        sp -= 1;
+        cur = stack[sp];
+    }
+}

@@ -1,0 +1,171 @@
+//! The triangle-only BVH: leaves hold triangles copied in leaf order into 4-wide SIMD
+//! blocks ([`Triangle4`]), intersected inline during traversal with no callback. This is
+//! the hot path of the renderer.
+
+use super::build::{BuildSettings, build_binary, collapse};
+use super::node::{MAX_LEAF_ITEMS, Node4, NodeRay, decode_leaf, encode_leaf};
+use super::traverse;
+use super::triangle4::{Triangle4, WatertightRay4, intersect4};
+use crate::render::geometry::triangle::WatertightRay;
+use crate::render::geometry::{Aabb, Ray};
+use glam::Vec3;
+
+/// A closest hit on a [`TriangleBvh`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeshHit {
+    pub t: f32,
+    /// Index of the triangle in the list given to the build.
+    pub prim: u32,
+    /// Barycentric weights of the triangle's three vertices at the hit.
+    pub b: [f32; 3],
+}
+
+/// A BVH over triangles that owns a leaf-ordered copy of their vertices.
+#[derive(Clone, Debug, Default)]
+pub struct TriangleBvh {
+    nodes: Vec<Node4>,
+    packets: Vec<Triangle4>,
+    order: Vec<u32>,
+    bounds: Aabb,
+}
+
+/// SAH in units of one 4-triangle block test; the 4-wide node visit costs about the same.
+/// Up to 8 triangles (two blocks) per leaf.
+const SETTINGS: BuildSettings = BuildSettings {
+    leaf_block: 4,
+    max_leaf: 8,
+    cost_traversal: 1.0,
+};
+
+impl TriangleBvh {
+    /// Builds over `triangles` (vertex indices into `vertices`). Triangles with an index
+    /// out of range or a non-finite vertex are left out (mesh loaders report those);
+    /// zero-area triangles are kept and never hit.
+    pub fn build(vertices: &[Vec3], triangles: &[[u32; 3]]) -> TriangleBvh {
+        let corners = |t: &[u32; 3]| -> Option<[Vec3; 3]> {
+            let p = [
+                *vertices.get(t[0] as usize)?,
+                *vertices.get(t[1] as usize)?,
+                *vertices.get(t[2] as usize)?,
+            ];
+            p.iter().all(|v| v.is_finite()).then_some(p)
+        };
+        let bounds: Vec<Aabb> = triangles
+            .iter()
+            .map(|t| corners(t).map_or(Aabb::EMPTY, |p| Aabb::from_points(&p)))
+            .collect();
+        let (root, order) = build_binary(&bounds, &SETTINGS);
+        let Some(root) = root else {
+            return TriangleBvh::default();
+        };
+        let mut packets = Vec::with_capacity(order.len() / 3);
+        let mut tris = Vec::with_capacity(MAX_LEAF_ITEMS as usize);
+        let nodes = collapse(&root, &mut |start, count| {
+            let first = packets.len() as u32;
+            let prims = &order[start as usize..(start + count) as usize];
+            for chunk in prims.chunks(4) {
+                tris.clear();
+                // Indices were validated when the bounds were made.
+                tris.extend(
+                    chunk
+                        .iter()
+                        .filter_map(|&i| corners(&triangles[i as usize])),
+                );
+                packets.push(Triangle4::new(&tris, chunk));
+            }
+            encode_leaf(first, packets.len() as u32 - first)
+        });
+        let bounds = order
+            .iter()
+            .fold(Aabb::EMPTY, |b, &i| b.union(&bounds[i as usize]));
+        TriangleBvh {
+            nodes,
+            packets,
+            order,
+            bounds,
+        }
+    }
+
+    /// Builds from a triangle soup (three corners per triangle).
+    pub fn from_soup(triangles: &[[Vec3; 3]]) -> TriangleBvh {
+        let vertices: Vec<Vec3> = triangles.iter().flatten().copied().collect();
+        let indices: Vec<[u32; 3]> = (0..triangles.len() as u32)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect();
+        TriangleBvh::build(&vertices, &indices)
+    }
+
+    /// Closest hit with 0 < t < t_max (watertight, two-sided).
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<MeshHit> {
+        let wr = WatertightRay4::new(&WatertightRay::new(ray));
+        let mut best: Option<MeshHit> = None;
+        traverse::closest(&self.nodes, &NodeRay::new(ray), t_max, |leaf, t_max| {
+            let (start, count) = decode_leaf(leaf);
+            let mut t_max = t_max;
+            let mut hit = false;
+            for packet in &self.packets[start..start + count] {
+                let lanes = intersect4(&wr, packet, t_max);
+                if lanes.hit == 0 {
+                    continue;
+                }
+                let t = lanes.t.to_array();
+                let mut lane = lanes.hit.trailing_zeros() as usize;
+                let mut rest = lanes.hit & (lanes.hit - 1);
+                while rest != 0 {
+                    let l = rest.trailing_zeros() as usize;
+                    if t[l & 3] < t[lane & 3] {
+                        lane = l;
+                    }
+                    rest &= rest - 1;
+                }
+                let lane = lane & 3;
+                let inv = lanes.inv_det[lane];
+                t_max = t[lane];
+                hit = true;
+                best = Some(MeshHit {
+                    t: t_max,
+                    prim: packet.prim[lane],
+                    b: [
+                        lanes.u[lane] * inv,
+                        lanes.v[lane] * inv,
+                        lanes.w[lane] * inv,
+                    ],
+                });
+            }
+            hit.then_some(t_max)
+        });
+        best
+    }
+
+    /// Whether anything is hit with 0 < t < t_max.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        let wr = WatertightRay4::new(&WatertightRay::new(ray));
+        traverse::any(&self.nodes, &NodeRay::new(ray), t_max, |leaf, t_max| {
+            let (start, count) = decode_leaf(leaf);
+            self.packets[start..start + count]
+                .iter()
+                .any(|p| intersect4(&wr, p, t_max).hit != 0)
+        })
+    }
+
+    /// Triangle indices in leaf order (see [`Bvh::prim_order`](super::Bvh::prim_order)).
+    pub fn prim_order(&self) -> &[u32] {
+        &self.order
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// Number of triangles in the tree.
+    pub fn triangle_count(&self) -> usize {
+        self.order.len()
+    }
+
+    /// (4-wide nodes, 4-triangle blocks), for statistics.
+    pub fn size(&self) -> (usize, usize) {
+        (self.nodes.len(), self.packets.len())
+    }
+}
