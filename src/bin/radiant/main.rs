@@ -1,22 +1,29 @@
 //! The `radiant` command line: a thin layer over the library.
 
+mod render_cmd;
+
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(
-    name = "radiant",
-    version,
-    about = "A physically based global-illumination renderer"
-)]
+#[command(name = "radiant", version, about = "A physically based global-illumination renderer")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Render a scene (default: the built-in Cornell box).
+    Render(render_cmd::RenderArgs),
+}
 
-fn main() -> anyhow::Result<()> {
+fn main() {
     let cli = Cli::parse();
-    match cli.command {}
+    let result = match cli.command {
+        Command::Render(args) => render_cmd::run(args),
+    };
+    if let Err(e) = result {
+        eprintln!("radiant: {e:#}");
+        std::process::exit(1);
+    }
 }

@@ -2,7 +2,7 @@
 //! weight. Pinhole/thin-lens perspective and orthographic projections live here; the
 //! realistic camera traces through a lens prescription (`realistic/`).
 
-mod projective;
+pub mod projective;
 
 use glam::Vec2;
 
@@ -30,5 +30,54 @@ impl Camera {
         match self {
             Camera::Projective(c) => Some(c.generate_ray(raster, u_lens)),
         }
+    }
+}
+
+/// Builds the camera of a scene for an image of `resolution` pixels.
+pub fn from_desc(
+    desc: &crate::scene::CameraDesc,
+    _film: &crate::scene::FilmDesc,
+    resolution: (u32, u32),
+) -> Result<Camera, crate::scene::SceneError> {
+    use crate::scene::{CameraKind, SceneError};
+    let world_from_camera = desc.camera_from_world.inverse();
+    let window = |w: &Option<[f32; 4]>| w.unwrap_or_else(|| projective::default_screen_window(resolution));
+    match &desc.kind {
+        CameraKind::Perspective {
+            fov_deg,
+            lens_radius,
+            focal_distance,
+            screen_window,
+        } => {
+            if !(*fov_deg > 0.0 && *fov_deg < 180.0) {
+                return Err(SceneError::at(&desc.loc, format!("fov must lie in (0, 180) degrees, got {fov_deg}")));
+            }
+            Ok(Camera::Projective(ProjectiveCamera {
+                projection: Projection::Perspective {
+                    tan_half_fov: (fov_deg.to_radians() / 2.0).tan(),
+                },
+                world_from_camera,
+                screen_window: window(screen_window),
+                resolution,
+                lens_radius: *lens_radius,
+                focal_distance: *focal_distance,
+            }))
+        }
+        CameraKind::Orthographic {
+            lens_radius,
+            focal_distance,
+            screen_window,
+        } => Ok(Camera::Projective(ProjectiveCamera {
+            projection: Projection::Orthographic,
+            world_from_camera,
+            screen_window: window(screen_window),
+            resolution,
+            lens_radius: *lens_radius,
+            focal_distance: *focal_distance,
+        })),
+        CameraKind::Realistic { .. } => Err(SceneError::at(
+            &desc.loc,
+            "Camera \"realistic\" is not available in this build",
+        )),
     }
 }

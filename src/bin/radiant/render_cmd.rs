@@ -1,0 +1,176 @@
+//! `radiant render`: render a scene file or a canonical scene to an image.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::Ordering;
+use std::time::Duration;
+
+use anyhow::{Context, bail};
+use clap::Args;
+use radiant::image::{ImageMeta, write_image};
+use radiant::render::{Overrides, Progress, Session};
+use radiant::scene::{SceneDesc, builtin::{BUILTIN_SCENES, builtin_scene}};
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// A pbrt-v4 scene file, or a canonical scene: cornell-box (default), cornell-caustics, furnace.
+    pub scene: Option<String>,
+    /// Samples per pixel (overrides the scene's Sampler "pixelsamples").
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Seed of the sampler (overrides the scene's).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long, alias = "nthreads")]
+    pub threads: Option<usize>,
+    /// Output image; the format follows the extension (.exr, .pfm, .png).
+    #[arg(short = 'o', long = "outfile")]
+    pub output: Option<PathBuf>,
+    /// Integrator, overriding the scene's (path, sppm, photonmap, radiosity).
+    #[arg(long)]
+    pub integrator: Option<String>,
+    /// Image size as WIDTHxHEIGHT, overriding the film's.
+    #[arg(long, value_parser = parse_resolution)]
+    pub resolution: Option<(u32, u32)>,
+    /// Exposure in stops for PNG output.
+    #[arg(long, default_value_t = 0.0)]
+    pub exposure: f32,
+    /// No progress bar and no summary.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got \"{s}\""))?;
+    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| n > 0);
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!("expected positive WIDTHxHEIGHT, got \"{s}\"")),
+    }
+}
+
+/// Reads a scene file, or builds a canonical scene by name.
+pub fn load_scene(scene: Option<&str>) -> anyhow::Result<SceneDesc> {
+    let name = scene.unwrap_or("cornell-box");
+    let path = Path::new(name);
+    if !path.exists() {
+        if let Some(desc) = builtin_scene(name) {
+            return Ok(desc);
+        }
+        if path.extension().is_none() {
+            bail!(
+                "{name}: no such scene file, and not a canonical scene ({})",
+                BUILTIN_SCENES.join(", ")
+            );
+        }
+    }
+    Ok(radiant::scene::parse_file(path)?)
+}
+
+pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    let desc = load_scene(args.scene.as_deref())?;
+    for w in &desc.warnings {
+        eprintln!("{w}");
+    }
+    let overrides = Overrides {
+        spp: args.spp,
+        seed: args.seed,
+        resolution: args.resolution,
+        integrator: args.integrator.clone(),
+    };
+    let session = Session::new(&desc, &overrides)?;
+    for w in &session.warnings {
+        eprintln!("{w}");
+    }
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(desc.output_name()));
+
+    let progress = Arc::new(Progress::default());
+    {
+        let progress = Arc::clone(&progress);
+        // A second Ctrl-C while the partial image is written still stops at once.
+        ctrlc::set_handler(move || {
+            if progress.cancel.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        })
+        .context("installing the Ctrl-C handler")?;
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .context("starting worker threads")?;
+    let show_bar = !args.quiet && std::io::stderr().is_terminal();
+    let output_data = std::thread::scope(|scope| {
+        let bar_done = Arc::new(std::sync::atomic::AtomicBool::new(false));
+        if show_bar {
+            let progress = Arc::clone(&progress);
+            let bar_done = Arc::clone(&bar_done);
+            scope.spawn(move || draw_progress(&progress, &bar_done));
+        }
+        let out = pool.install(|| session.render(&progress));
+        bar_done.store(true, Ordering::SeqCst);
+        out
+    });
+
+    let meta = ImageMeta {
+        samples_per_pixel: Some(output_data.spp_done),
+        render_time_seconds: Some(output_data.seconds),
+        software: format!("radiant {}", env!("CARGO_PKG_VERSION")),
+    };
+    write_image(&output, &output_data.film.image(), &meta, args.exposure)
+        .with_context(|| format!("writing {}", output.display()))?;
+    let nf = output_data.film.nonfinite;
+    if nf.count > 0 {
+        let (x, y) = nf.first_pixel.unwrap_or((0, 0));
+        eprintln!(
+            "warning: {} non-finite sample(s) dropped (first at pixel {x},{y})",
+            nf.count
+        );
+    }
+    if !args.quiet {
+        eprintln!(
+            "{}: {}x{}, {} spp, {} integrator, {:.2} s, {:.2} Mrays/s",
+            output.display(),
+            session.resolution.0,
+            session.resolution.1,
+            output_data.spp_done,
+            session.integrator.name(),
+            output_data.seconds,
+            output_data.rays as f64 / output_data.seconds.max(1e-9) / 1e6
+        );
+    }
+    if output_data.interrupted {
+        bail!(
+            "interrupted: wrote the image so far ({} spp) to {}",
+            output_data.spp_done,
+            output.display()
+        );
+    }
+    Ok(())
+}
+
+fn draw_progress(progress: &Progress, done: &std::sync::atomic::AtomicBool) {
+    let bar = indicatif::ProgressBar::new(progress.total.load(Ordering::Relaxed).max(1));
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {percent:>3}% samples {human_pos}/{human_len} {elapsed} ETA {eta} {msg}",
+        )
+        .expect("valid template"),
+    );
+    let start = std::time::Instant::now();
+    while !done.load(Ordering::SeqCst) {
+        std::thread::sleep(Duration::from_millis(200));
+        bar.set_length(progress.total.load(Ordering::Relaxed).max(1));
+        bar.set_position(progress.done.load(Ordering::Relaxed));
+        let mrays = progress.rays.load(Ordering::Relaxed) as f64 / start.elapsed().as_secs_f64() / 1e6;
+        bar.set_message(format!("{mrays:.1} Mrays/s"));
+    }
+    bar.finish_and_clear();
+}

@@ -1,0 +1,57 @@
+//! Integrators: the path tracer (reference), and the photon mappers and radiosity
+//! built on the same world. `Integrator` is chosen by name from the scene (or the
+//! command line) and reads its own parameters.
+
+pub mod path;
+
+pub use path::PathSettings;
+
+use crate::scene::{IntegratorDesc, SceneError, Warning};
+
+/// The integrators radiant implements, with their settings.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Integrator {
+    Path(PathSettings),
+}
+
+/// Names accepted by `Integrator` and `--integrator`.
+pub const INTEGRATOR_NAMES: [&str; 1] = ["path"];
+
+impl Integrator {
+    /// Chooses the integrator from a scene's `Integrator` directive. Names radiant does
+    /// not implement fall back to the path tracer with a warning; unused parameters are
+    /// reported as warnings.
+    pub fn from_desc(desc: &IntegratorDesc) -> Result<(Integrator, Vec<Warning>), SceneError> {
+        let mut warnings = Vec::new();
+        let integrator = match desc.name.as_str() {
+            "path" => Integrator::Path(PathSettings::from_desc(desc)?),
+            "volpath" => {
+                warnings.push(Warning {
+                    loc: desc.loc.clone(),
+                    message: "integrator \"volpath\": participating media are not supported; using \"path\"".into(),
+                });
+                Integrator::Path(PathSettings::from_desc(desc)?)
+            }
+            other => {
+                warnings.push(Warning {
+                    loc: desc.loc.clone(),
+                    message: format!(
+                        "integrator \"{other}\" is not supported (radiant has: {}); using \"path\"",
+                        INTEGRATOR_NAMES.join(", ")
+                    ),
+                });
+                // Read what the path tracer shares (maxdepth) so it is not reported unused.
+                Integrator::Path(PathSettings::from_desc(desc)?)
+            }
+        };
+        let owner = format!("Integrator \"{}\"", desc.name);
+        warnings.extend(desc.params.unused_warnings(&owner));
+        Ok((integrator, warnings))
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Path(_) => "path",
+        }
+    }
+}
