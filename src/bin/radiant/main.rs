@@ -1,5 +1,7 @@
 //! The `radiant` command line: a thin layer over the library.
 
+mod lens_cmd;
+
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
@@ -14,9 +16,14 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Inspect a realistic-camera lens file: paraxial data, focus, field of view, exit pupil.
+    Lens(lens_cmd::LensArgs),
+}
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
-    match cli.command {}
+    match cli.command {
+        Command::Lens(args) => lens_cmd::run(args),
+    }
 }
