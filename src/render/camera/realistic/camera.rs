@@ -23,6 +23,7 @@ use crate::math::{DVec2, DVec3, Vec2, Vec3};
 /// A camera ray in camera space (metres; +z forward, +x right, +y up) and its weight.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraRaySample {
+    /// Where the ray leaves the front element.
     pub origin: Vec3,
     /// Unit direction.
     pub dir: Vec3,

@@ -33,6 +33,7 @@ impl LensSurface {
 pub struct LensPrescription {
     /// Where it came from (file name or a label), used in messages.
     pub name: String,
+    /// Interfaces from the front element to the rear.
     pub surfaces: Vec<LensSurface>,
 }
 

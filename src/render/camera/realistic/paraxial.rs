@@ -9,13 +9,18 @@ use super::{LensError, LensSystem};
 /// A 2×2 ray-transfer matrix acting on (y, n·u).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Abcd {
+    /// Height from height.
     pub a: f64,
+    /// Height from reduced angle.
     pub b: f64,
+    /// Reduced angle from height (−power).
     pub c: f64,
+    /// Reduced angle from reduced angle.
     pub d: f64,
 }
 
 impl Abcd {
+    /// The matrix that changes nothing.
     pub const IDENTITY: Abcd = Abcd {
         a: 1.0,
         b: 0.0,
@@ -58,6 +63,7 @@ impl Abcd {
         (self.a * y + self.b * nu, self.c * y + self.d * nu)
     }
 
+    /// n_in / n_out for a physical system (1 between air spaces).
     pub fn determinant(&self) -> f64 {
         self.a * self.d - self.b * self.c
     }
@@ -84,13 +90,17 @@ pub struct ParaxialData {
     pub total_track: f64,
     /// Index of the aperture stop (front element = 0).
     pub stop_index: usize,
+    /// Aperture stop position and (current) diameter.
     pub stop_z: f64,
+    /// Current stop diameter.
     pub stop_diameter: f64,
     /// Entrance pupil (paraxial image of the stop through the elements in front of it).
     pub entrance_pupil_z: f64,
+    /// Entrance pupil diameter.
     pub entrance_pupil_diameter: f64,
     /// Exit pupil position relative to the rear vertex (negative: in front of it).
     pub exit_pupil_from_rear: f64,
+    /// Exit pupil diameter.
     pub exit_pupil_diameter: f64,
     /// Paraxial f-number EFL / entrance-pupil diameter (the stop limits the axial bundle).
     pub f_number: f64,

@@ -14,7 +14,8 @@
 //! 4. padding for the film radii between the samples (half the largest change between
 //!    neighbouring samples, or a film-sample step where the region vanishes).
 //!
-//! About 10⁶ exact traces per lens, instead of the 10⁸–10⁹ of a brute-force sampling.
+//! About 5·10⁵ exact traces per lens (0.15–0.25 s on two busy cores), where densely sampling
+//! every bucket (e.g. 1024² rear-plane points × 64 buckets) takes ~7·10⁷.
 
 use super::{ApertureClipping, LensError, LensRay, LensSystem};
 use crate::math::{DVec2, DVec3};
@@ -24,12 +25,16 @@ use rayon::prelude::*;
 /// y in [−y_max, y_max] (mm, lens space).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PupilRect {
+    /// Lower x bound.
     pub x_min: f64,
+    /// Upper x bound.
     pub x_max: f64,
+    /// Half-height: y lies in [−y_max, y_max].
     pub y_max: f64,
 }
 
 impl PupilRect {
+    /// Area in mm².
     pub fn area(&self) -> f64 {
         (self.x_max - self.x_min) * 2.0 * self.y_max
     }

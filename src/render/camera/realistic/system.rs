@@ -50,7 +50,9 @@ pub enum ApertureClipping {
 /// A ray in lens space (mm); `dir` is unit length.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LensRay {
+    /// Start point.
     pub origin: DVec3,
+    /// Unit direction.
     pub dir: DVec3,
 }
 
