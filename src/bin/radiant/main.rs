@@ -1,5 +1,6 @@
 //! The `radiant` command line: a thin layer over the library.
 
+mod lens_cmd;
 mod render_cmd;
 
 use clap::{Parser, Subcommand};
@@ -15,12 +16,15 @@ struct Cli {
 enum Command {
     /// Render a scene (default: the built-in Cornell box).
     Render(render_cmd::RenderArgs),
+    /// Inspect a realistic-camera lens file: paraxial data, focus, field of view, exit pupil.
+    Lens(lens_cmd::LensArgs),
 }
 
 fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(args),
+        Command::Lens(args) => lens_cmd::run(args),
     };
     if let Err(e) = result {
         eprintln!("radiant: {e:#}");

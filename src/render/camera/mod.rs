@@ -3,6 +3,7 @@
 //! realistic camera traces through a lens prescription (`realistic/`).
 
 pub mod projective;
+pub mod realistic;
 
 use glam::Vec2;
 
