@@ -55,6 +55,8 @@ pub struct Session {
     pub spp: u32,
     pub seed: u64,
     pub sampler: SamplerKind,
+    /// The sensor's imaging ratio, ISO / 100 (pbrt-v4's `PixelSensor` with a 1 s shutter).
+    pub imaging_ratio: f32,
     /// Warnings from preparing the session (the parser's are in the scene).
     pub warnings: Vec<Warning>,
 }
@@ -83,7 +85,7 @@ impl Session {
             .unwrap_or((desc.film.xresolution, desc.film.yresolution));
         let (world, w) = World::build(desc)?;
         warnings.extend(w);
-        let camera = super::camera::from_desc(&desc.camera, &desc.film, resolution)?;
+        let camera = super::camera::from_desc(&desc.camera, &desc.film, resolution, &mut warnings)?;
         let filter = match desc.filter.kind {
             crate::scene::FilterKind::Box => Filter::box_filter(desc.filter.radius),
             crate::scene::FilterKind::Triangle => Filter::triangle(desc.filter.radius),
@@ -98,6 +100,7 @@ impl Session {
             spp: overrides.spp.unwrap_or(desc.sampler.pixel_samples).max(1),
             seed: overrides.seed.unwrap_or(desc.sampler.seed),
             sampler: desc.sampler.kind,
+            imaging_ratio: desc.film.iso / 100.0,
             warnings,
         })
     }
@@ -182,6 +185,6 @@ impl Session {
         let (l, rays) = match &self.integrator {
             Integrator::Path(s) => path::radiance(&self.world, s, cr.ray, &mut sampler),
         };
-        (l * cr.weight, fs.weight, rays)
+        (l * (cr.weight * self.imaging_ratio), fs.weight, rays)
     }
 }

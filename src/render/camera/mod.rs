@@ -22,6 +22,12 @@ pub struct CameraRay {
 #[derive(Clone, Debug)]
 pub enum Camera {
     Projective(ProjectiveCamera),
+    /// A lens prescription in front of the film; rays are made in camera space (metres)
+    /// and carried to render space by `world_from_camera`.
+    Realistic {
+        camera: Box<realistic::RealisticCamera>,
+        world_from_camera: crate::math::Transform,
+    },
 }
 
 impl Camera {
@@ -30,6 +36,19 @@ impl Camera {
     pub fn generate_ray(&self, raster: Vec2, u_lens: Vec2) -> Option<CameraRay> {
         match self {
             Camera::Projective(c) => Some(c.generate_ray(raster, u_lens)),
+            Camera::Realistic {
+                camera,
+                world_from_camera,
+            } => {
+                let s = camera.generate_ray(raster, u_lens)?;
+                Some(CameraRay {
+                    ray: Ray::new(
+                        world_from_camera.point(s.origin),
+                        world_from_camera.vector(s.dir).normalize(),
+                    ),
+                    weight: s.weight,
+                })
+            }
         }
     }
 }
@@ -37,8 +56,9 @@ impl Camera {
 /// Builds the camera of a scene for an image of `resolution` pixels.
 pub fn from_desc(
     desc: &crate::scene::CameraDesc,
-    _film: &crate::scene::FilmDesc,
+    film: &crate::scene::FilmDesc,
     resolution: (u32, u32),
+    warnings: &mut Vec<crate::scene::Warning>,
 ) -> Result<Camera, crate::scene::SceneError> {
     use crate::scene::{CameraKind, SceneError};
     let world_from_camera = desc.camera_from_world.inverse();
@@ -76,9 +96,31 @@ pub fn from_desc(
             lens_radius: *lens_radius,
             focal_distance: *focal_distance,
         })),
-        CameraKind::Realistic { .. } => Err(SceneError::at(
-            &desc.loc,
-            "Camera \"realistic\" is not available in this build",
-        )),
+        CameraKind::Realistic {
+            lens_file,
+            aperture_diameter_mm,
+            focus_distance,
+        } => {
+            let lens_error = |e: realistic::LensError| SceneError::at(&desc.loc, format!("Camera \"realistic\": {e}"));
+            let lens = realistic::LensPrescription::from_file(lens_file).map_err(lens_error)?;
+            let camera = realistic::RealisticCamera::new(
+                lens,
+                *aperture_diameter_mm as f64,
+                *focus_distance as f64,
+                film.diagonal_mm as f64,
+                resolution,
+            )
+            .map_err(lens_error)?;
+            for w in camera.warnings() {
+                warnings.push(crate::scene::Warning {
+                    loc: desc.loc.clone(),
+                    message: format!("Camera \"realistic\": {w}"),
+                });
+            }
+            Ok(Camera::Realistic {
+                camera: Box::new(camera),
+                world_from_camera,
+            })
+        }
     }
 }
