@@ -164,6 +164,13 @@ pub struct AreaLightDesc {
 pub enum Geometry {
     /// Triangles: three indices each into `positions`. Optional per-vertex shading
     /// normals and uvs (same length as `positions`).
+    ///
+    /// Which side faces out (pbrt-v4): without `normals`, the geometric normal is
+    /// (p1 - p0) × (p2 - p0) in render space, flipped when `reverse_orientation` is set
+    /// or when `render_from_object` swaps handedness (both: no flip). With `normals`,
+    /// the shading normal (interpolated N, transformed as a normal, negated when
+    /// `reverse_orientation` is set) is authoritative: the geometric normal is turned
+    /// to its side. A one-sided area light emits on the side of the geometric normal.
     TriangleMesh {
         positions: Vec<Vec3>,
         indices: Vec<u32>,
@@ -198,7 +205,8 @@ pub enum Geometry {
 pub struct ShapeDesc {
     pub geometry: Geometry,
     pub render_from_object: Transform,
-    /// `ReverseOrientation` was in effect (flips the normal, and so the emitting side).
+    /// `ReverseOrientation` was in effect (flips the normal, and so the emitting side;
+    /// for meshes with shading normals it flips those, see [`Geometry::TriangleMesh`]).
     pub reverse_orientation: bool,
     pub material: MaterialId,
     pub area_light: Option<AreaLightDesc>,

@@ -5,8 +5,16 @@
 pub mod builtin;
 pub mod desc;
 pub mod error;
+pub mod mesh;
+pub mod named_spectra;
+pub mod obj;
 pub mod params;
+pub mod parser;
+pub mod ply;
+pub mod spectrum;
+pub mod token;
 
 pub use desc::*;
 pub use error::{FileLoc, SceneError, Warning};
 pub use params::{Param, ParamSet, ParamValue};
+pub use parser::{parse_file, parse_str};

@@ -88,6 +88,12 @@ impl Param {
             used: Cell::new(false),
         }
     }
+
+    /// Marks the parameter as used, so that it is never reported (for parameters that
+    /// came from `Attribute` defaults, or that a single "unsupported" warning covers).
+    pub fn mark_used(&self) {
+        self.used.set(true);
+    }
 }
 
 /// The parameter list of one directive.
@@ -200,6 +206,16 @@ impl ParamSet {
                 format!("parameter \"{name}\" must be finite"),
             ))
         }
+    }
+
+    /// Marks every parameter as used (one "unsupported" warning then covers them all).
+    pub fn mark_all_used(&self) {
+        self.params.iter().for_each(Param::mark_used);
+    }
+
+    /// True when a parameter of this name is present; does not mark it used.
+    pub fn has(&self, name: &str) -> bool {
+        self.params.iter().any(|p| p.name == name)
     }
 
     /// Parameters never looked up, as warnings naming the object they were given to.
