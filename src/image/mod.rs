@@ -2,6 +2,7 @@
 //! EXR / PFM / PNG writers and readers, and the error metrics used to compare renders.
 
 pub mod film;
+pub mod filter;
 
 use crate::color::Rgb;
 
