@@ -9,4 +9,5 @@
 pub mod color;
 pub mod image;
 pub mod math;
+pub mod radiosity;
 pub mod render;

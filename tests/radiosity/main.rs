@@ -1,0 +1,6 @@
+//! Acceptance tests of the radiosity module against the reference data in
+//! `../shared/data` (formfactors.json, enclosures.json, hemicube_errors.json).
+
+mod common;
+mod formfactors;
+mod hemicube;
