@@ -216,3 +216,54 @@ mod tests {
         assert!((f - radius * radius / (radius * radius + h * h)).abs() < 1e-15);
     }
 }
+
+#[cfg(test)]
+mod far_field_tests {
+    use super::*;
+    use crate::math::hash::Pcg32;
+
+    #[test]
+    fn disk_approximation_error_shrinks_with_distance() {
+        // Unit squares in random orientations facing a point at distance r (measured
+        // from the centre; both cosines >= 0.2): the relative error of the disk
+        // approximation against the exact contour factor, worst case over 2000
+        // orientations, must fall like area / r^2.
+        let mut rng = Pcg32::new(3, 4);
+        let mut random_unit = || {
+            let z = 2.0 * rng.uniform_f64() - 1.0;
+            let phi = std::f64::consts::TAU * rng.uniform_f64();
+            let r = (1.0 - z * z).sqrt();
+            DVec3::new(r * phi.cos(), r * phi.sin(), z)
+        };
+        for ratio in [4.0f64, 16.0, 64.0] {
+            let distance = ratio.sqrt();
+            let mut worst = 0.0f64;
+            for _ in 0..2000 {
+                let direction = random_unit();
+                let mut normal = random_unit();
+                // Face the point with cosines at least 0.2 each way.
+                if normal.dot(-direction) < 0.0 {
+                    normal = -normal;
+                }
+                let receiver_normal = random_unit();
+                if normal.dot(-direction) < 0.2 || receiver_normal.dot(direction) < 0.2 {
+                    continue;
+                }
+                let centre = direction * distance;
+                let (s, t) = crate::radiosity::patch::tangent_frame(normal);
+                let square = [
+                    centre - 0.5 * s - 0.5 * t,
+                    centre + 0.5 * s - 0.5 * t,
+                    centre + 0.5 * s + 0.5 * t,
+                    centre - 0.5 * s + 0.5 * t,
+                ];
+                let exact = point_polygon_factor(DVec3::ZERO, receiver_normal, &square, normal);
+                let approx =
+                    point_disk_approximation(DVec3::ZERO, receiver_normal, centre, normal, 1.0);
+                worst = worst.max((approx / exact - 1.0).abs());
+            }
+            // Measured: 0.23, 0.070, 0.018, i.e. about 1.1 / ratio.
+            assert!(worst < 1.5 / ratio, "ratio {ratio}: {worst}");
+        }
+    }
+}

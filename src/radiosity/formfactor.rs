@@ -44,7 +44,8 @@ pub struct RayCastSettings {
     pub shadow_rays_per_side: usize,
     /// When `distance^2 > ratio * area` between the patch centroids (area of the patch
     /// the factor points to), use the point-to-disk approximation instead of the
-    /// contour: relative error O(1/ratio), a third of the cost. `None`: always exact.
+    /// contour: relative error about `1.1 / ratio` at worst (grazing angles), a fifth
+    /// of the cost. `None`: always exact.
     pub far_field_ratio: Option<f64>,
     pub seed: u64,
 }
@@ -66,13 +67,14 @@ impl Default for RayCastSettings {
 
 impl RayCastSettings {
     /// One point per patch and one shadow ray per pair, with the far-field
-    /// approximation beyond 16 areas: the per-pair cost the progressive solver needs on
-    /// large meshes.
+    /// approximation beyond a distance of 8 patch sizes (error <= 1.8 % per factor at
+    /// grazing angles, typically far less): the per-pair cost the progressive solver
+    /// needs on large meshes.
     pub fn fast() -> Self {
         RayCastSettings {
             quadrature: Quadrature::Centroid,
             shadow_rays_per_side: 1,
-            far_field_ratio: Some(16.0),
+            far_field_ratio: Some(64.0),
             seed: 0,
         }
     }
@@ -124,40 +126,45 @@ impl RayCaster {
         if from == to {
             return 0.0;
         }
-        let source = set.polygon(from);
-        let target = set.polygon(to);
-        if !faces_each_other(set, from, &source, to, &target) {
-            return 0.0;
-        }
-        let mut rng = Pcg32::new(hash_u64s(&[self.settings.seed, from as u64, to as u64]), 0);
-        let mut sum = 0.0;
+        let needs_jitter = self.settings.shadow_rays_per_side > 1 && !vis.always_visible();
         match &self.rule {
             None => {
-                sum = set.patches[from].area
-                    * self.point_factor(
-                        set,
-                        set.patches[from].centroid,
-                        from,
-                        to,
-                        &target,
-                        vis,
-                        &mut rng,
-                    );
+                // One point: no pre-test (the point factor is zero anyway for patches
+                // that do not face each other) and no random numbers unless several
+                // shadow rays need them. This is the progressive solver's hot path.
+                let mut rng = if needs_jitter {
+                    self.pair_rng(from, to)
+                } else {
+                    Pcg32::new(0, 0)
+                };
+                let x = set.patches[from].centroid;
+                self.point_factor(set, x, from, to, vis, &mut rng)
             }
             Some(rule) => {
+                let source = set.polygon(from);
+                if !faces_each_other(set, from, &source, to, &set.polygon(to)) {
+                    return 0.0;
+                }
+                let mut rng = self.pair_rng(from, to);
                 // Shadow-ray jitter draws from its own stream so the quadrature points do
                 // not depend on whether rays are cast.
                 let mut shadow_rng = Pcg32::new(rng.next_u32() as u64, 1);
+                let mut sum = 0.0;
                 rule.for_each_point(source.as_slice(), &mut rng, |x, w| {
-                    sum += w * self.point_factor(set, x, from, to, &target, vis, &mut shadow_rng);
+                    sum += w * self.point_factor(set, x, from, to, vis, &mut shadow_rng);
                 });
+                sum / set.patches[from].area
             }
         }
-        sum / set.patches[from].area
+    }
+
+    /// The random stream of one ordered patch pair: a pure function of the seed and the
+    /// pair, so results do not depend on the order or thread of evaluation.
+    fn pair_rng(&self, from: usize, to: usize) -> Pcg32 {
+        Pcg32::new(hash_u64s(&[self.settings.seed, from as u64, to as u64]), 0)
     }
 
     /// Factor from the point `x` on patch `from` to patch `to`, times the visible fraction.
-    #[allow(clippy::too_many_arguments)]
     #[inline]
     fn point_factor<V: Visibility>(
         &self,
@@ -165,7 +172,6 @@ impl RayCaster {
         x: DVec3,
         from: usize,
         to: usize,
-        target: &Polygon,
         vis: &V,
         rng: &mut Pcg32,
     ) -> f64 {
@@ -184,7 +190,7 @@ impl RayCaster {
                 target_patch.area,
             )
         } else {
-            point_polygon_factor(x, n, target.as_slice(), target_patch.normal)
+            point_polygon_factor(x, n, set.polygon(to).as_slice(), target_patch.normal)
         };
         if f == 0.0 || vis.always_visible() {
             return f;
@@ -206,7 +212,7 @@ impl RayCaster {
         let mut visible_count = 0.0;
         let mut count = 0.0;
         self.shadow_rule
-            .for_each_point(target.as_slice(), rng, |y, w| {
+            .for_each_point(set.polygon(to).as_slice(), rng, |y, w| {
                 let d = y - x;
                 let d2 = d.length_squared();
                 let kernel = w * n.dot(d).max(0.0) * (-target_normal.dot(d)).max(0.0) / (d2 * d2);

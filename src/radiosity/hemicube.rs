@@ -87,7 +87,7 @@ const MAX_CLIPPED: usize = 8;
 impl HemiCube {
     /// Precomputes the delta form factors for `resolution` cells across the top face.
     pub fn new(resolution: usize) -> Result<HemiCube, HemiCubeError> {
-        if resolution < 2 || resolution % 2 != 0 {
+        if resolution < 2 || !resolution.is_multiple_of(2) {
             return Err(HemiCubeError::Resolution(resolution));
         }
         let cell = 2.0 / resolution as f64;
@@ -362,7 +362,15 @@ fn clip_against_plane(polygon: &mut [DVec3; MAX_CLIPPED], count: usize, plane: D
     for &b in &input[..count] {
         let db = plane.dot(b);
         if (da >= 0.0) != (db >= 0.0) && out < MAX_CLIPPED {
-            polygon[out] = a + (b - a) * (da / (da - db));
+            // Interpolate from the lexicographically smaller endpoint, so that the two
+            // patches sharing this edge (which traverse it in opposite directions) get
+            // bit-identical clip points and hence no crack between them.
+            let (p, q, dp, dq) = if (a.x, a.y, a.z) < (b.x, b.y, b.z) {
+                (a, b, da, db)
+            } else {
+                (b, a, db, da)
+            };
+            polygon[out] = p + (q - p) * (dp / (dp - dq));
             out += 1;
         }
         if db >= 0.0 && out < MAX_CLIPPED {

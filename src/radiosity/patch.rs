@@ -220,7 +220,9 @@ pub fn polygon_shape(corners: &[DVec3]) -> Result<PolygonShape, PatchError> {
         .iter()
         .map(|c| (*c - v0).length())
         .fold(0.0, f64::max);
-    if !(doubled_area > 1e-14 * diameter * diameter) || !doubled_area.is_finite() {
+    // Written so that a NaN area is rejected too.
+    let large_enough = doubled_area > 1e-14 * diameter * diameter;
+    if !large_enough || !doubled_area.is_finite() {
         return Err(PatchError::Degenerate(doubled_area / 2.0));
     }
     let normal = (corners[1] - v0).cross(corners[2] - v0).normalize();

@@ -260,9 +260,7 @@ pub fn solve_progressive<V: Visibility>(
                             partial.absorbed[band] += patch.area * (arriving - reflected);
                         }
                     }
-                    for band in 0..3 {
-                        partial.unshot_power[band] += patch.area * db[band];
-                    }
+                    add_scaled(&mut partial.unshot_power, db, patch.area);
                     let score = selection_score(patch.area, db, settings.selection);
                     if score > partial.best_score {
                         partial.best_score = score;
@@ -276,25 +274,21 @@ pub fn solve_progressive<V: Visibility>(
         shooter = None;
         let mut unshot_power = [0.0; 3];
         for p in &partials {
-            for band in 0..3 {
-                state.absorbed[band] += p.absorbed[band];
-                state.escaped[band] -= p.incident[band];
-                unshot_power[band] += p.unshot_power[band];
-            }
+            add_scaled(&mut state.absorbed, &p.absorbed, 1.0);
+            add_scaled(&mut state.escaped, &p.incident, -1.0);
+            add_scaled(&mut unshot_power, &p.unshot_power, 1.0);
             if p.best_score > best_score {
                 best_score = p.best_score;
                 shooter = Some(p.best);
             }
         }
-        for band in 0..3 {
-            state.escaped[band] += area_i * shot[band];
-        }
+        add_scaled(&mut state.escaped, &shot, area_i);
         state.unshot_power = unshot_power;
         state.shots += 1;
         fractions.push(state.unshot_fraction());
         fractions_per_band.push(state.unshot_fraction_per_band());
         converged = fraction(&state) <= settings.unshot_tolerance;
-        if settings.callback_every > 0 && state.shots % settings.callback_every == 0 {
+        if settings.callback_every > 0 && state.shots.is_multiple_of(settings.callback_every) {
             on_progress(&state);
         }
     }
@@ -304,6 +298,14 @@ pub fn solve_progressive<V: Visibility>(
         unshot_fraction_per_band: fractions_per_band,
         converged,
     })
+}
+
+/// `sum += scale * value`, per band.
+#[inline]
+fn add_scaled(sum: &mut [f64; 3], value: &[f64; 3], scale: f64) {
+    for (s, v) in sum.iter_mut().zip(value) {
+        *s += scale * v;
+    }
 }
 
 #[inline]

@@ -4,6 +4,8 @@
 
 use glam::DVec3;
 
+use thiserror::Error;
+
 use super::patch::{PatchError, PatchSet};
 
 /// Cornell box reflectances (RGB) as in `enclosures.json`: white, red, green.
@@ -93,22 +95,43 @@ pub fn cornell_like_box(
     Ok(set)
 }
 
-/// The inside of a sphere of `radius` about the origin, cut by `rings + 1` planes of
-/// constant z spaced evenly (so every ring has the same area on the sphere) and by
-/// `segments` meridians. Patches are planar trapezoids (triangles at the poles) facing
-/// the centre, ordered ring by ring from the bottom, `segments` per ring; every patch
-/// of a ring gets `material(ring)`, which returns `(emission, reflectance)`.
+/// Why a shape could not be built.
+#[derive(Debug, Error, PartialEq)]
+pub enum ShapeError {
+    #[error(transparent)]
+    Patch(#[from] PatchError),
+    #[error("sphere ring heights must rise strictly from -radius to radius (at least 3)")]
+    RingHeights,
+}
+
+/// Ring heights `-R + 2R k / rings` (`k = 0..=rings`): every ring then has the same area
+/// on the sphere (Archimedes), but rings near the poles are wide in angle.
+pub fn uniform_z_rings(radius: f64, rings: usize) -> Vec<f64> {
+    (0..=rings)
+        .map(|k| radius * (-1.0 + 2.0 * k as f64 / rings as f64))
+        .collect()
+}
+
+/// The inside of a sphere of `radius` about the origin, cut by the planes
+/// `z = ring_heights[k]` (rising from `-radius` to `radius`) and by `segments`
+/// meridians. Patches are planar trapezoids (triangles at the poles) facing the
+/// centre, ordered ring by ring from the bottom, `segments` per ring; every patch of
+/// ring `k` gets `material(k)`, which returns `(emission, reflectance)`.
 pub fn sphere_interior(
     radius: f64,
-    rings: usize,
+    ring_heights: &[f64],
     segments: usize,
     material: impl Fn(usize) -> ([f64; 3], [f64; 3]),
-) -> Result<PatchSet, PatchError> {
+) -> Result<PatchSet, ShapeError> {
+    let rings = ring_heights.len().saturating_sub(1);
+    let rising = ring_heights.windows(2).all(|w| w[0] < w[1]);
+    if rings < 2 || !rising || ring_heights[0] != -radius || ring_heights[rings] != radius {
+        return Err(ShapeError::RingHeights);
+    }
     let mut set = PatchSet::new();
-    // Ring k (0..=rings) at z = -R + 2R k / rings; the poles are single points.
+    // The poles are single points.
     let mut ring_start = Vec::with_capacity(rings + 1);
-    for k in 0..=rings {
-        let z = radius * (-1.0 + 2.0 * k as f64 / rings as f64);
+    for (k, &z) in ring_heights.iter().enumerate() {
         ring_start.push(set.points.len() as u32);
         if k == 0 || k == rings {
             set.add_point(DVec3::new(0.0, 0.0, z));

@@ -2,5 +2,7 @@
 //! `../shared/data` (formfactors.json, enclosures.json, hemicube_errors.json).
 
 mod common;
+mod enclosures;
 mod formfactors;
 mod hemicube;
+mod meshes;
