@@ -67,8 +67,8 @@ impl Default for RayCastSettings {
 
 impl RayCastSettings {
     /// One point per patch and one shadow ray per pair, with the far-field
-    /// approximation beyond a distance of 8 patch sizes (error <= 1.8 % per factor at
-    /// grazing angles, typically far less): the per-pair cost the progressive solver
+    /// approximation beyond a distance of 8 patch sizes (error <= 1.8 % per factor for
+    /// cosines above 0.2, typically far less): the per-pair cost the progressive solver
     /// needs on large meshes.
     pub fn fast() -> Self {
         RayCastSettings {
@@ -95,6 +95,7 @@ pub struct RayCaster {
 const GRADING_RATIO: f64 = 0.3;
 
 impl RayCaster {
+    /// Prepares the quadrature rules for `settings`.
     pub fn new(settings: RayCastSettings) -> RayCaster {
         let rule = match settings.quadrature {
             Quadrature::Centroid => None,
@@ -117,6 +118,7 @@ impl RayCaster {
         }
     }
 
+    /// The settings this caster was built with.
     pub fn settings(&self) -> &RayCastSettings {
         &self.settings
     }

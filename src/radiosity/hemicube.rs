@@ -131,6 +131,7 @@ impl HemiCube {
         })
     }
 
+    /// Cells across the top face.
     pub fn resolution(&self) -> usize {
         self.resolution
     }

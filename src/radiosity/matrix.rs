@@ -36,6 +36,7 @@ impl<T: Copy + Into<f64>> FormFactorMatrix<T> {
         self.n
     }
 
+    /// True for a 0 x 0 matrix.
     pub fn is_empty(&self) -> bool {
         self.n == 0
     }

@@ -71,14 +71,17 @@ pub struct PatchSet {
 const PLANARITY_TOLERANCE: f64 = 1e-6;
 
 impl PatchSet {
+    /// An empty set.
     pub fn new() -> PatchSet {
         PatchSet::default()
     }
 
+    /// Number of patches.
     pub fn len(&self) -> usize {
         self.patches.len()
     }
 
+    /// True when there are no patches.
     pub fn is_empty(&self) -> bool {
         self.patches.is_empty()
     }
@@ -171,6 +174,7 @@ impl PatchSet {
         }
     }
 
+    /// Sum of the patch areas.
     pub fn total_area(&self) -> f64 {
         self.patches.iter().map(|p| p.area).sum()
     }

@@ -85,10 +85,12 @@ impl Rule1D {
         Rule1D { nodes, weights }
     }
 
+    /// Number of nodes.
     pub fn len(&self) -> usize {
         self.nodes.len()
     }
 
+    /// True for a rule without nodes.
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
     }

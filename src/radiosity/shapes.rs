@@ -8,9 +8,11 @@ use thiserror::Error;
 
 use super::patch::{PatchError, PatchSet};
 
-/// Cornell box reflectances (RGB) as in `enclosures.json`: white, red, green.
+/// Cornell box white reflectance (RGB), as in `enclosures.json`.
 pub const CORNELL_WHITE: [f64; 3] = [0.885809, 0.698859, 0.666422];
+/// Cornell box red reflectance (RGB).
 pub const CORNELL_RED: [f64; 3] = [0.570068, 0.0430135, 0.0443706];
+/// Cornell box green reflectance (RGB).
 pub const CORNELL_GREEN: [f64; 3] = [0.105421, 0.37798, 0.076425];
 /// The Cornell light's exitance `pi L` with `L = (18.387, 13.9873, 6.75357)`.
 pub const CORNELL_LIGHT: [f64; 3] = [57.76446412155553, 43.94239892355651, 21.21696589750442];

@@ -62,6 +62,7 @@ pub struct SolveReport {
 }
 
 impl SolveReport {
+    /// Number of sweeps performed.
     pub fn iterations(&self) -> usize {
         self.residuals.len()
     }

@@ -53,6 +53,7 @@ struct Blocker {
 const END_TOLERANCE: f64 = 1e-9;
 
 impl BruteForceVisibility {
+    /// Copies the patch polygons with their planes and bounding boxes.
     pub fn new(set: &PatchSet) -> BruteForceVisibility {
         let blockers = (0..set.len())
             .map(|i| {

@@ -2,6 +2,7 @@
 //! `../shared/data` (formfactors.json, enclosures.json, hemicube_errors.json).
 
 mod common;
+mod computed;
 mod enclosures;
 mod formfactors;
 mod hemicube;
