@@ -5,6 +5,8 @@
 //! Run: `cargo bench --bench radiosity` (`RAYON_NUM_THREADS=2` to match the target
 //! machine).
 
+use std::ops::ControlFlow;
+
 use divan::Bencher;
 use radiant::radiosity::shapes::cornell_like_box;
 use radiant::radiosity::{
@@ -36,7 +38,7 @@ fn progressive_10k_patches_to_1_percent(bencher: Bencher) {
             ShootingFactors::RayCast(&caster),
             &AlwaysVisible,
             ProgressiveSettings::default(),
-            |_| {},
+            |_| ControlFlow::Continue(()),
         )
         .expect("valid settings");
         assert!(report.converged);

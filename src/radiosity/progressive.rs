@@ -12,6 +12,8 @@
 //! openings of an open scene). So `emitted = absorbed + escaped + unshot` holds at every
 //! step, to rounding, whatever the factors.
 
+use std::ops::ControlFlow;
+
 use rayon::prelude::*;
 use thiserror::Error;
 
@@ -78,6 +80,8 @@ pub struct ProgressiveState {
     pub radiosity: Vec<[f64; 3]>,
     /// Unshot radiosity `dB`, per patch and band.
     pub unshot: Vec<[f64; 3]>,
+    /// Irradiance `H` gathered so far (power arriving per unit area), per patch and band.
+    pub irradiance: Vec<[f64; 3]>,
     pub shots: usize,
     /// Power per band: emitted in total, absorbed by patches so far, escaped so far
     /// (reached no patch), and still unshot.
@@ -95,6 +99,7 @@ impl ProgressiveState {
         ProgressiveState {
             radiosity: emission.clone(),
             unshot: emission,
+            irradiance: vec![[0.0; 3]; set.len()],
             shots: 0,
             emitted,
             absorbed: [0.0; 3],
@@ -165,6 +170,8 @@ pub struct ProgressiveReport {
     /// The same per band.
     pub unshot_fraction_per_band: Vec<[f64; 3]>,
     pub converged: bool,
+    /// The progress hook asked to stop before convergence.
+    pub stopped: bool,
 }
 
 /// Receivers per parallel work item. Fixed (not derived from the thread count) so that
@@ -182,13 +189,14 @@ struct ShotPartial {
 }
 
 /// Shoots until the unshot fraction reaches the tolerance. `on_progress` sees the state
-/// every `callback_every` shots (e.g. to write the classic image sequence).
+/// every `callback_every` shots (e.g. to write the classic image sequence) and may stop
+/// the solve early by returning `ControlFlow::Break` (e.g. on Ctrl-C).
 pub fn solve_progressive<V: Visibility>(
     set: &PatchSet,
     factors: ShootingFactors<'_>,
     vis: &V,
     settings: ProgressiveSettings,
-    mut on_progress: impl FnMut(&ProgressiveState),
+    mut on_progress: impl FnMut(&ProgressiveState) -> ControlFlow<()>,
 ) -> Result<ProgressiveReport, ProgressiveError> {
     let n = set.len();
     if let ShooterSelection::Band(b) = settings.selection
@@ -221,7 +229,8 @@ pub fn solve_progressive<V: Visibility>(
     };
     let mut shooter = best_shooter(set, &state.unshot, settings.selection);
     let mut converged = fraction(&state) <= settings.unshot_tolerance;
-    while !converged && state.shots < settings.max_shots {
+    let mut stopped = false;
+    while !converged && !stopped && state.shots < settings.max_shots {
         let Some(i) = shooter else { break };
         let shot = state.unshot[i];
         state.unshot[i] = [0.0; 3];
@@ -242,11 +251,13 @@ pub fn solve_progressive<V: Visibility>(
             .radiosity
             .par_chunks_mut(CHUNK)
             .zip(state.unshot.par_chunks_mut(CHUNK))
+            .zip(state.irradiance.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(chunk, (radiosity, unshot))| {
+            .map(|(chunk, ((radiosity, unshot), irradiance))| {
                 let mut partial = ShotPartial::default();
                 let first = chunk * CHUNK;
-                for (k, (b, db)) in radiosity.iter_mut().zip(unshot.iter_mut()).enumerate() {
+                let receivers = radiosity.iter_mut().zip(unshot.iter_mut()).zip(irradiance.iter_mut());
+                for (k, ((b, db), h)) in receivers.enumerate() {
                     let j = first + k;
                     let patch = &set.patches[j];
                     let c = coefficient(j);
@@ -254,6 +265,7 @@ pub fn solve_progressive<V: Visibility>(
                         for band in 0..3 {
                             let arriving = c * shot[band];
                             let reflected = patch.reflectance[band] * arriving;
+                            h[band] += arriving;
                             b[band] += reflected;
                             db[band] += reflected;
                             partial.incident[band] += patch.area * arriving;
@@ -288,8 +300,11 @@ pub fn solve_progressive<V: Visibility>(
         fractions.push(state.unshot_fraction());
         fractions_per_band.push(state.unshot_fraction_per_band());
         converged = fraction(&state) <= settings.unshot_tolerance;
-        if settings.callback_every > 0 && state.shots.is_multiple_of(settings.callback_every) {
-            on_progress(&state);
+        if settings.callback_every > 0
+            && state.shots.is_multiple_of(settings.callback_every)
+            && on_progress(&state).is_break()
+        {
+            stopped = !converged;
         }
     }
     Ok(ProgressiveReport {
@@ -297,6 +312,7 @@ pub fn solve_progressive<V: Visibility>(
         unshot_fraction: fractions,
         unshot_fraction_per_band: fractions_per_band,
         converged,
+        stopped,
     })
 }
 

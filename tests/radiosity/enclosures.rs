@@ -1,5 +1,7 @@
 //! Solvers against enclosures.json with the exact factors given.
 
+use std::ops::ControlFlow;
+
 use radiant::radiosity::report::{energy_balance, irradiance};
 use radiant::radiosity::{
     AlwaysVisible, FormFactorMatrix, IterationSettings, PatchSet, ProgressiveSettings,
@@ -48,7 +50,7 @@ fn all_solvers_reproduce_b_from_the_exact_factors() {
                 unshot_tolerance: 1e-14,
                 ..ProgressiveSettings::default()
             },
-            |_| {},
+            |_| ControlFlow::Continue(()),
         )
         .unwrap();
         assert!(jacobi.converged && seidel.converged && shooting.converged);
@@ -98,7 +100,7 @@ fn iteration_counts_are_comparable_to_the_reference() {
                 unshot_tolerance: 1e-6,
                 ..ProgressiveSettings::default()
             },
-            |_| {},
+            |_| ControlFlow::Continue(()),
         )
         .unwrap()
         .state
@@ -148,7 +150,7 @@ fn shooting_one_band_reproduces_the_unshot_power_trace() {
                 selection: ShooterSelection::Band(0),
                 callback_every: 0,
             },
-            |_| {},
+            |_| ControlFlow::Continue(()),
         )
         .unwrap();
         let trace = f64s(&c["checks"]["progressive_unshot_fraction_first20_band0"]);
@@ -277,7 +279,10 @@ fn ambient_term_makes_the_display_exact_in_a_uniform_sphere() {
             callback_every: 1,
             ..ProgressiveSettings::default()
         },
-        |state| seen.push(max_abs_difference(&state.display_radiosity(&set), &exact)),
+        |state| {
+            seen.push(max_abs_difference(&state.display_radiosity(&set), &exact));
+            ControlFlow::Continue(())
+        },
     )
     .unwrap();
     assert_eq!(seen.len(), 6);

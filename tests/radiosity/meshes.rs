@@ -1,6 +1,8 @@
 //! Meshed enclosures: closure, reciprocity, agreement between the factor methods and
 //! solvers, energy bookkeeping, determinism.
 
+use std::ops::ControlFlow;
+
 use radiant::math::DVec3;
 use radiant::radiosity::report::{closure, closure_error, energy_balance, reciprocity};
 use radiant::radiosity::shapes::cornell_like_box;
@@ -149,7 +151,7 @@ fn shooting_with_on_the_fly_factors_matches_the_stored_matrix() {
             unshot_tolerance: 1e-12,
             ..ProgressiveSettings::default()
         },
-        |_| {},
+        |_| ControlFlow::Continue(()),
     )
     .unwrap();
     assert!(shot.converged);
@@ -176,7 +178,7 @@ fn shooting_with_hemicubes_matches_shooting_with_their_matrix() {
         ShootingFactors::HemiCube(&hemicube),
         &AlwaysVisible,
         settings,
-        |_| {},
+        |_| ControlFlow::Continue(()),
     )
     .unwrap();
     let stored = solve_progressive(
@@ -184,7 +186,7 @@ fn shooting_with_hemicubes_matches_shooting_with_their_matrix() {
         ShootingFactors::Matrix(&f),
         &AlwaysVisible,
         settings,
-        |_| {},
+        |_| ControlFlow::Continue(()),
     )
     .unwrap();
     assert_eq!(on_the_fly.state.shots, stored.state.shots);
@@ -245,6 +247,7 @@ fn shooting_books_every_watt() {
                 let gap = s.emitted[b] - s.absorbed[b] - s.escaped[b] - s.unshot_power[b];
                 worst = worst.max(gap.abs() / s.emitted[b]);
             }
+            ControlFlow::Continue(())
         },
     )
     .unwrap();
@@ -287,7 +290,7 @@ fn results_do_not_depend_on_the_thread_count() {
                     ShootingFactors::RayCast(&caster),
                     &AlwaysVisible,
                     ProgressiveSettings::default(),
-                    |_| {},
+                    |_| ControlFlow::Continue(()),
                 )
                 .unwrap();
                 let jacobi = solve_jacobi(&set, &f, TIGHT, |_, _| {}).unwrap();
@@ -340,7 +343,7 @@ fn mismatched_inputs_are_errors_not_panics() {
                 selection,
                 ..ProgressiveSettings::default()
             },
-            |_| {},
+            |_| ControlFlow::Continue(()),
         )
         .map(|r| r.converged)
     };
@@ -367,7 +370,7 @@ fn mismatched_inputs_are_errors_not_panics() {
         ShootingFactors::RayCast(&caster),
         &AlwaysVisible,
         ProgressiveSettings::default(),
-        |_| {},
+        |_| ControlFlow::Continue(()),
     )
     .unwrap();
     assert!(report.converged && report.state.shots == 0);
