@@ -85,6 +85,16 @@ impl World {
         !self.occluded(&Ray::new(o, d), 1.0 - 1e-4)
     }
 
+    /// Bounding spheres (centre, radius) of the specular geometry (mirrors, conductors,
+    /// glass): one per mesh, quadric or instance that has any.
+    pub fn specular_bounds(&self) -> Vec<(Vec3, f32)> {
+        let pick = |m: u32| {
+            let m = &self.materials[m as usize];
+            m.is_specular() && *m != Material::Interface
+        };
+        self.geometry.bounding_spheres_where(&self.prototypes, &pick)
+    }
+
     pub fn accel(&self) -> &Bvh {
         &self.geometry.bvh
     }

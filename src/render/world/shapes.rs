@@ -118,6 +118,51 @@ impl ShapeSet {
             .collect()
     }
 
+    /// Bounding spheres (centre, radius) of the primitives whose material satisfies
+    /// `pick`, in render space: one per mesh (over its picked triangles), one per
+    /// quadric (exact for spheres), one per instance whose prototype holds any. Used to
+    /// aim photons at specular objects (projection maps).
+    pub(crate) fn bounding_spheres_where(
+        &self,
+        prototypes: &[ShapeSet],
+        pick: &dyn Fn(u32) -> bool,
+    ) -> Vec<(Vec3, f32)> {
+        let all = self.prim_bounds(prototypes);
+        let box_sphere = |b: &Aabb| (b.center(), 0.5 * b.diagonal().length());
+        let mut per_mesh = vec![Aabb::EMPTY; self.meshes.len()];
+        let mut out = Vec::new();
+        for (prim, bounds) in self.prims.iter().zip(&all) {
+            match *prim {
+                PrimRef::Triangle(i) => {
+                    let attr = &self.triangle_attrs[i as usize];
+                    if pick(attr.material) {
+                        let b = &mut per_mesh[attr.mesh as usize];
+                        *b = b.union(bounds);
+                    }
+                }
+                PrimRef::Sphere(i) if pick(self.spheres[i as usize].material) => {
+                    let s = &self.spheres[i as usize];
+                    // The largest axis scale bounds the transformed sphere.
+                    let m = glam::Mat3::from_mat4(s.render_from_object.m);
+                    let scale = m.x_axis.length().max(m.y_axis.length()).max(m.z_axis.length());
+                    let exact = (s.render_from_object.point(Vec3::ZERO), s.shape.radius * scale);
+                    let loose = box_sphere(bounds);
+                    out.push(if exact.1 <= loose.1 { exact } else { loose });
+                }
+                PrimRef::Disk(i) if pick(self.disks[i as usize].material) => out.push(box_sphere(bounds)),
+                PrimRef::Instance(i) => {
+                    let proto = &prototypes[self.instances[i as usize].prototype as usize];
+                    if !proto.bounding_spheres_where(&[], pick).is_empty() {
+                        out.push(box_sphere(bounds));
+                    }
+                }
+                _ => {}
+            }
+        }
+        out.extend(per_mesh.iter().filter(|b| !b.is_empty()).map(box_sphere));
+        out
+    }
+
     fn intersect_raw(&self, ray: &Ray, t_max: f32, prototypes: &[ShapeSet]) -> Option<(f32, RawHit, Option<u32>)> {
         let wt = WatertightRay::new(ray);
         let mut best: Option<(RawHit, Option<u32>)> = None;
