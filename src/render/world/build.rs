@@ -6,10 +6,8 @@ use glam::{Mat3, Vec2, Vec3};
 use super::shapes::{Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr};
 use super::{NO_LIGHT, World};
 use crate::math::{Distribution1D, Transform};
-use crate::render::accel::Bvh;
 use crate::render::geometry::disk::Disk;
 use crate::render::geometry::sphere::Sphere;
-use crate::render::geometry::Aabb;
 use crate::render::light::{AreaLight, Light, LightShape, SceneSphere};
 use crate::render::material::Material;
 use crate::scene::{AreaLightDesc, Geometry, LightDesc, SceneDesc, SceneError, ShapeDesc, Warning};
@@ -32,7 +30,7 @@ impl World {
                 // pbrt does not support area lights in instances either; the parser warned.
                 add_shape(&mut set, shape, &materials, None, &mut warnings)?;
             }
-            finish(&mut set, &[]);
+            set.finish(&[]);
             prototypes.push(set);
         }
 
@@ -51,8 +49,8 @@ impl World {
             });
             top.prims.push(PrimRef::Instance(i));
         }
-        finish(&mut top, &prototypes);
-        let bounds = top.bvh.bounds();
+        top.finish(&prototypes);
+        let bounds = top.bounds();
 
         let mut world = World {
             geometry: top,
@@ -81,10 +79,6 @@ impl World {
     }
 }
 
-fn finish(set: &mut ShapeSet, prototypes: &[ShapeSet]) {
-    let bounds: Vec<Aabb> = set.prim_bounds(prototypes);
-    set.bvh = Bvh::build(&bounds);
-}
 
 fn light_from_desc(l: &LightDesc) -> Light {
     match l {
@@ -315,7 +309,6 @@ fn add_mesh(
                 }
             }
         };
-        let i = set.triangles.len() as u32;
         set.triangles.push(pts);
         set.triangle_attrs.push(TriangleAttr {
             mesh,
@@ -324,7 +317,6 @@ fn add_mesh(
             light,
             orientation,
         });
-        set.prims.push(PrimRef::Triangle(i));
     }
     set.meshes.push(MeshAttrs {
         indices,

@@ -13,7 +13,6 @@ pub use build::BuildError;
 pub use shapes::ShapeSet;
 
 use crate::math::Distribution1D;
-use crate::render::accel::Bvh;
 use crate::render::geometry::ray::offset_origin;
 use crate::render::geometry::{Aabb, Ray};
 use crate::render::light::Light;
@@ -83,10 +82,6 @@ impl World {
         };
         let d = target - o;
         !self.occluded(&Ray::new(o, d), 1.0 - 1e-4)
-    }
-
-    pub fn accel(&self) -> &Bvh {
-        &self.geometry.bvh
     }
 
     /// Centre and radius of a sphere enclosing the scene (for distant and infinite lights).

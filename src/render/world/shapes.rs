@@ -4,16 +4,15 @@ use glam::{Vec2, Vec3};
 
 use super::{NO_LIGHT, SurfaceHit};
 use crate::math::Transform;
-use crate::render::accel::Bvh;
+use crate::render::accel::{Bvh, TriangleBvh};
 use crate::render::geometry::disk::Disk;
 use crate::render::geometry::sphere::Sphere;
-use crate::render::geometry::triangle::{WatertightRay, intersect_triangle};
 use crate::render::geometry::{Aabb, Ray};
 
-/// Which array a BVH primitive lives in, and its index there.
+/// Which array a primitive of the generic BVH lives in, and its index there.
+/// Triangles have their own SIMD BVH and never appear here.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum PrimRef {
-    Triangle(u32),
     Sphere(u32),
     Disk(u32),
     Instance(u32),
@@ -57,7 +56,10 @@ pub(crate) struct Instance {
     pub render_from_instance: Transform,
 }
 
-/// A set of primitives with its BVH: the scene's top level, or an instance prototype.
+/// A set of primitives with its BVHs: the scene's top level, or an instance prototype.
+/// Triangles — nearly always the bulk — sit in a SIMD triangle BVH; spheres, disks and
+/// instances in a generic one. A ray visits both, the second with the first's hit
+/// distance as its limit.
 #[derive(Default)]
 pub struct ShapeSet {
     pub(crate) triangles: Vec<[Vec3; 3]>,
@@ -66,7 +68,8 @@ pub struct ShapeSet {
     pub(crate) spheres: Vec<Placed<Sphere>>,
     pub(crate) disks: Vec<Placed<Disk>>,
     pub(crate) instances: Vec<Instance>,
-    /// BVH primitive index → primitive.
+    pub(crate) triangle_bvh: TriangleBvh,
+    /// Generic BVH primitive index → primitive.
     pub(crate) prims: Vec<PrimRef>,
     pub(crate) bvh: Bvh,
 }
@@ -79,12 +82,23 @@ enum RawHit {
 }
 
 impl ShapeSet {
+    /// Number of primitives: triangles, quadrics and instances.
     pub fn len(&self) -> usize {
-        self.prims.len()
+        self.triangles.len() + self.prims.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.prims.is_empty()
+        self.len() == 0
+    }
+
+    /// Builds both BVHs; prototypes must be finished before the sets that instance them.
+    pub(crate) fn finish(&mut self, prototypes: &[ShapeSet]) {
+        self.triangle_bvh = TriangleBvh::from_soup(&self.triangles);
+        self.bvh = Bvh::build(&self.prim_bounds(prototypes));
+    }
+
+    pub(crate) fn bounds(&self) -> Aabb {
+        self.triangle_bvh.bounds().union(&self.bvh.bounds())
     }
 
     /// Render-space bounds of every primitive, in `prims` order.
@@ -92,7 +106,6 @@ impl ShapeSet {
         self.prims
             .iter()
             .map(|prim| match *prim {
-                PrimRef::Triangle(i) => Aabb::from_points(&self.triangles[i as usize]),
                 PrimRef::Sphere(i) => {
                     let s = &self.spheres[i as usize];
                     let r = s.shape.radius;
@@ -111,7 +124,7 @@ impl ShapeSet {
                     let inst = &self.instances[i as usize];
                     transformed_box(
                         &inst.render_from_instance,
-                        prototypes[inst.prototype as usize].bvh.bounds(),
+                        prototypes[inst.prototype as usize].bounds(),
                     )
                 }
             })
@@ -119,44 +132,47 @@ impl ShapeSet {
     }
 
     fn intersect_raw(&self, ray: &Ray, t_max: f32, prototypes: &[ShapeSet]) -> Option<(f32, RawHit, Option<u32>)> {
-        let wt = WatertightRay::new(ray);
-        let mut best: Option<(RawHit, Option<u32>)> = None;
-        let t = self.bvh.closest_hit(ray, t_max, |prim, t_max| {
-            match self.prims[prim as usize] {
-                PrimRef::Triangle(i) => {
-                    let [p0, p1, p2] = self.triangles[i as usize];
-                    let h = intersect_triangle(&wt, p0, p1, p2, t_max)?;
-                    best = Some((RawHit::Triangle { index: i, b: h.b }, None));
-                    Some(h.t)
-                }
-                PrimRef::Sphere(i) => {
-                    let s = &self.spheres[i as usize];
-                    let h = s.shape.intersect(&object_ray(&s.render_from_object, ray), t_max)?;
-                    best = Some((
-                        RawHit::Quadric { prim: PrimRef::Sphere(i), p_obj: h.p, n_obj: h.n, uv: h.uv },
-                        None,
-                    ));
-                    Some(h.t)
-                }
-                PrimRef::Disk(i) => {
-                    let d = &self.disks[i as usize];
-                    let h = d.shape.intersect(&object_ray(&d.render_from_object, ray), t_max)?;
-                    best = Some((
-                        RawHit::Quadric { prim: PrimRef::Disk(i), p_obj: h.p, n_obj: Vec3::Z, uv: h.uv },
-                        None,
-                    ));
-                    Some(h.t)
-                }
-                PrimRef::Instance(i) => {
-                    let inst = &self.instances[i as usize];
-                    let local = object_ray(&inst.render_from_instance, ray);
-                    let (t, raw, _) = prototypes[inst.prototype as usize].intersect_raw(&local, t_max, &[])?;
-                    best = Some((raw, Some(i)));
-                    Some(t)
-                }
+        let mut best: Option<(f32, RawHit, Option<u32>)> = None;
+        let mut t_max = t_max;
+        if let Some(h) = self.triangle_bvh.intersect(ray, t_max) {
+            t_max = h.t;
+            best = Some((h.t, RawHit::Triangle { index: h.prim, b: h.b }, None));
+        }
+        if self.prims.is_empty() {
+            return best;
+        }
+        let mut quadric: Option<(RawHit, Option<u32>)> = None;
+        let t = self.bvh.closest_hit(ray, t_max, |prim, t_max| match self.prims[prim as usize] {
+            PrimRef::Sphere(i) => {
+                let s = &self.spheres[i as usize];
+                let h = s.shape.intersect(&object_ray(&s.render_from_object, ray), t_max)?;
+                quadric = Some((
+                    RawHit::Quadric { prim: PrimRef::Sphere(i), p_obj: h.p, n_obj: h.n, uv: h.uv },
+                    None,
+                ));
+                Some(h.t)
             }
-        })?;
-        best.map(|(raw, inst)| (t, raw, inst))
+            PrimRef::Disk(i) => {
+                let d = &self.disks[i as usize];
+                let h = d.shape.intersect(&object_ray(&d.render_from_object, ray), t_max)?;
+                quadric = Some((
+                    RawHit::Quadric { prim: PrimRef::Disk(i), p_obj: h.p, n_obj: Vec3::Z, uv: h.uv },
+                    None,
+                ));
+                Some(h.t)
+            }
+            PrimRef::Instance(i) => {
+                let inst = &self.instances[i as usize];
+                let local = object_ray(&inst.render_from_instance, ray);
+                let (t, raw, _) = prototypes[inst.prototype as usize].intersect_raw(&local, t_max, &[])?;
+                quadric = Some((raw, Some(i)));
+                Some(t)
+            }
+        });
+        match (t, quadric) {
+            (Some(t), Some((raw, inst))) => Some((t, raw, inst)),
+            _ => best,
+        }
     }
 
     pub(crate) fn intersect(&self, ray: &Ray, t_max: f32, prototypes: &[ShapeSet]) -> Option<SurfaceHit> {
@@ -176,26 +192,25 @@ impl ShapeSet {
     }
 
     pub(crate) fn occluded(&self, ray: &Ray, t_max: f32, prototypes: &[ShapeSet]) -> bool {
-        let wt = WatertightRay::new(ray);
-        self.bvh.any_hit(ray, t_max, |prim, t_max| match self.prims[prim as usize] {
-            PrimRef::Triangle(i) => {
-                let [p0, p1, p2] = self.triangles[i as usize];
-                intersect_triangle(&wt, p0, p1, p2, t_max).is_some()
-            }
-            PrimRef::Sphere(i) => {
-                let s = &self.spheres[i as usize];
-                s.shape.intersect(&object_ray(&s.render_from_object, ray), t_max).is_some()
-            }
-            PrimRef::Disk(i) => {
-                let d = &self.disks[i as usize];
-                d.shape.intersect(&object_ray(&d.render_from_object, ray), t_max).is_some()
-            }
-            PrimRef::Instance(i) => {
-                let inst = &self.instances[i as usize];
-                let local = object_ray(&inst.render_from_instance, ray);
-                prototypes[inst.prototype as usize].occluded(&local, t_max, &[])
-            }
-        })
+        if self.triangle_bvh.occluded(ray, t_max) {
+            return true;
+        }
+        !self.prims.is_empty()
+            && self.bvh.any_hit(ray, t_max, |prim, t_max| match self.prims[prim as usize] {
+                PrimRef::Sphere(i) => {
+                    let s = &self.spheres[i as usize];
+                    s.shape.intersect(&object_ray(&s.render_from_object, ray), t_max).is_some()
+                }
+                PrimRef::Disk(i) => {
+                    let d = &self.disks[i as usize];
+                    d.shape.intersect(&object_ray(&d.render_from_object, ray), t_max).is_some()
+                }
+                PrimRef::Instance(i) => {
+                    let inst = &self.instances[i as usize];
+                    let local = object_ray(&inst.render_from_instance, ray);
+                    prototypes[inst.prototype as usize].occluded(&local, t_max, &[])
+                }
+            })
     }
 
     fn surface_hit(&self, t: f32, raw: RawHit) -> SurfaceHit {
