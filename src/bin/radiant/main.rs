@@ -1,5 +1,7 @@
 //! The `radiant` command line: a thin layer over the library.
 
+mod compare_cmd;
+
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
@@ -14,9 +16,14 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
-enum Command {}
+enum Command {
+    /// Error metrics of a render against a reference image (B is the reference).
+    Compare(compare_cmd::CompareArgs),
+}
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
-    match cli.command {}
+    match cli.command {
+        Command::Compare(args) => compare_cmd::run(args),
+    }
 }
