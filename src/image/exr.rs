@@ -293,13 +293,19 @@ mod tests {
             render_time_seconds: Some(0.75),
             software: String::new(),
         };
-        let (a, b) = (temp_path("det_a.exr"), temp_path("det_b.exr"));
-        write_exr(&a, &img, &meta).unwrap();
-        write_exr(&b, &img, &meta).unwrap();
-        let (bytes_a, bytes_b) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
-        std::fs::remove_file(&a).ok();
-        std::fs::remove_file(&b).ok();
-        assert_eq!(bytes_a, bytes_b);
+        // Each write builds fresh attribute HashMaps with fresh random hash keys; were two
+        // custom attributes to share a map, 4 writes would all agree with chance 1/8.
+        let write = |i: usize| {
+            let path = temp_path(&format!("det_{i}.exr"));
+            write_exr(&path, &img, &meta).unwrap();
+            let bytes = std::fs::read(&path).unwrap();
+            std::fs::remove_file(&path).ok();
+            bytes
+        };
+        let bytes_a = write(0);
+        for i in 1..4 {
+            assert!(write(i) == bytes_a, "write {i} differs from write 0");
+        }
         // The header (everything before the first zero-padded pixel block) holds no date
         // attribute and no hostname-ish owner.
         let header = &bytes_a[..bytes_a.len().min(2048)];

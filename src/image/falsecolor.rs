@@ -110,7 +110,7 @@ const HUE_RANGE: (f32, f32) = (305.0, 100.0);
 const CHROMA_KNOTS: [f32; 5] = [0.115, 0.11, 0.09, 0.15, 0.10];
 const LUT_SIZE: usize = 256;
 
-/// The ramp's colour (linear sRGB, in [0,1]) for `t` in [0,1]; `t` is clamped and NaN
+/// The ramp's colour (linear sRGB, in 0..=1) for `t` in 0..=1; `t` is clamped and NaN
 /// maps to 0. Interpolates a 256-entry table built once.
 pub fn colormap(t: f32) -> Rgb {
     static LUT: OnceLock<Vec<Rgb>> = OnceLock::new();

@@ -1,6 +1,6 @@
 //! Pixel reconstruction filters used by *filter importance sampling*: each camera sample
 //! is placed at the pixel centre plus an offset drawn from the filter, and contributes to
-//! its own pixel only, with weight f(offset)/pdf(offset) normalised so that E[weight] = 1.
+//! its own pixel only, with weight f(offset)/pdf(offset) normalised so that E(weight) = 1.
 //! Pixels stay independent (no splatting into neighbours), so a parallel render writes
 //! each pixel from one thread and the result does not depend on scheduling.
 //! (Ernst, Stamminger, Greiner, "Filter Importance Sampling", IEEE Symposium on
@@ -145,7 +145,7 @@ fn sample_tent(u: f32) -> f32 {
     }
 }
 
-/// Segments of the tabulated per-axis Gaussian density.
+/// Segments of the tabulated per-axis Gaussian density (a power of two; see `sample`).
 const GAUSSIAN_SEGMENTS: usize = 1024;
 
 /// One axis of the Gaussian filter, sampled by inverting a piecewise-*linear*
@@ -165,6 +165,9 @@ pub struct GaussianAxis {
     node_values: Vec<f32>,
     /// Cumulative trapezoid areas, `cdf[0] = 0`, unnormalised (total = cdf[N]).
     cdf: Vec<f64>,
+    /// `guide[k]` = the last segment i with `cdf[i] <= k/N · total`: sampling starts there
+    /// and scans forward a step or two instead of binary-searching the whole CDF.
+    guide: Vec<u32>,
     /// ∫ g over [-r, r] (composite Simpson, f64).
     integral: f64,
 }
@@ -179,6 +182,7 @@ impl GaussianAxis {
             offset,
             node_values: Vec::with_capacity(GAUSSIAN_SEGMENTS + 1),
             cdf: Vec::with_capacity(GAUSSIAN_SEGMENTS + 1),
+            guide: Vec::with_capacity(GAUSSIAN_SEGMENTS),
             integral: 0.0,
         };
         let h = 2.0 * radius / GAUSSIAN_SEGMENTS as f32;
@@ -203,6 +207,12 @@ impl GaussianAxis {
             s += g(-radius as f64 + i as f64 * hs) * if i % 2 == 1 { 4.0 } else { 2.0 };
         }
         axis.integral = s * hs / 3.0;
+        let total = acc;
+        for k in 0..GAUSSIAN_SEGMENTS {
+            let level = k as f64 / GAUSSIAN_SEGMENTS as f64 * total;
+            let i = axis.cdf.partition_point(|&c| c <= level).saturating_sub(1);
+            axis.guide.push(i.min(GAUSSIAN_SEGMENTS - 1) as u32);
+        }
         axis
     }
 
@@ -217,13 +227,15 @@ impl GaussianAxis {
     /// Returns (x, g(x) / interpolant(x)).
     fn sample(&self, u: f32) -> (f32, f32) {
         let total = self.cdf[GAUSSIAN_SEGMENTS];
-        let target = u.clamp(0.0, 1.0) as f64 * total;
-        // Last segment i with cdf[i] <= target, skipping empty segments.
-        let i = self
-            .cdf
-            .partition_point(|&c| c <= target)
-            .saturating_sub(1)
-            .min(GAUSSIAN_SEGMENTS - 1);
+        let u = u.clamp(0.0, 1.0) as f64;
+        let target = u * total;
+        // Last segment i with cdf[i] <= target. N is a power of two, so k/N·total <= target
+        // holds exactly for k = floor(u·N) and the guide never starts past the answer.
+        let k = ((u * GAUSSIAN_SEGMENTS as f64) as usize).min(GAUSSIAN_SEGMENTS - 1);
+        let mut i = self.guide[k] as usize;
+        while i + 1 < GAUSSIAN_SEGMENTS && self.cdf[i + 1] <= target {
+            i += 1;
+        }
         let area = self.cdf[i + 1] - self.cdf[i];
         let (a, b) = (self.node_values[i] as f64, self.node_values[i + 1] as f64);
         let local = if area > 0.0 {
@@ -402,6 +414,36 @@ mod tests {
             assert!(
                 s.weight.is_finite() && s.offset.abs().max_element() <= 1.5,
                 "{s:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn guide_table_finds_the_same_segment_as_binary_search() {
+        let Filter::Gaussian { tables, .. } = Filter::default() else {
+            unreachable!()
+        };
+        let axis = &tables[0];
+        let total = axis.cdf[GAUSSIAN_SEGMENTS];
+        let mut rng = Pcg32::new(5, 5);
+        for j in 0..20_000 {
+            let u = if j < 2 {
+                j as f32 * crate::math::ONE_MINUS_EPSILON
+            } else {
+                rng.uniform()
+            };
+            let target = u as f64 * total;
+            let i = axis
+                .cdf
+                .partition_point(|&c| c <= target)
+                .saturating_sub(1)
+                .min(GAUSSIAN_SEGMENTS - 1);
+            let h = 2.0 * axis.radius as f64 / GAUSSIAN_SEGMENTS as f64;
+            let x = axis.sample(u).0 as f64 + axis.radius as f64;
+            // The sample lies in segment i (up to f32 rounding of x).
+            assert!(
+                x >= i as f64 * h - 1e-6 && x <= (i + 1) as f64 * h + 1e-6,
+                "u={u}"
             );
         }
     }

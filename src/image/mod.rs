@@ -231,3 +231,59 @@ pub fn read_image(path: impl AsRef<Path>) -> Result<Image, ImageError> {
         Format::Png => png::read_png(path),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dispatch_by_extension_is_case_insensitive() {
+        let dir = std::env::temp_dir().join(format!("radiant-dispatch-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut img = Image::new(3, 2);
+        img.set(2, 1, Rgb::new(0.5, 2.0, 1e-3));
+        for name in ["a.EXR", "b.Pfm", "c.exr", "d.pfm"] {
+            let path = dir.join(name);
+            write_image(&path, &img, &ImageMeta::default(), 0.0).unwrap();
+            assert_eq!(read_image(&path).unwrap(), img, "{name}");
+            std::fs::remove_file(&path).ok();
+        }
+        // PNG clips 2.0 to white and quantises: check the format was really PNG.
+        let path = dir.join("e.PNG");
+        write_image(&path, &img, &ImageMeta::default(), 0.0).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::remove_file(&path).ok();
+        assert_eq!(&bytes[1..4], b"PNG");
+
+        for bad in ["f.jpg", "noextension"] {
+            let err = write_image(dir.join(bad), &img, &ImageMeta::default(), 0.0)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains(bad) && err.contains("unknown image format"),
+                "{err}"
+            );
+            let err = read_image(dir.join(bad)).unwrap_err().to_string();
+            assert!(err.contains(bad), "{err}");
+        }
+    }
+
+    #[test]
+    fn crop_parses_and_checks() {
+        let c: Crop = "1, 2,30,40".parse().unwrap();
+        assert_eq!((c.x0, c.y0, c.x1, c.y1), (1, 2, 30, 40));
+        assert!("1,2,3".parse::<Crop>().is_err());
+        assert!("1,2,3,-4".parse::<Crop>().is_err());
+        assert!(c.check(30, 40).is_ok());
+        assert!(c.check(29, 40).is_err());
+        let empty = Crop { x1: 1, ..c };
+        assert!(empty.check(30, 40).is_err());
+    }
+
+    #[test]
+    fn writers_reject_empty_images() {
+        let path = std::env::temp_dir().join("radiant-empty.pfm");
+        let err = write_image(&path, &Image::new(0, 4), &ImageMeta::default(), 0.0).unwrap_err();
+        assert!(matches!(err, ImageError::InvalidImage { .. }), "{err}");
+    }
+}

@@ -2,7 +2,7 @@
 //!
 //! Display encoding: scale linear radiance by 2^exposure, apply the sRGB opto-electronic
 //! transfer function of IEC 61966-2-1:1999 (the exact piecewise curve, linear toe below
-//! 0.0031308), clamp to [0,1] only then, and round to the nearest of 256 levels. No tone
+//! 0.0031308), clamp to 0..=1 only then, and round to the nearest of 256 levels. No tone
 //! curve: values above 1 after exposure clip to white.
 
 use std::io::BufWriter;
