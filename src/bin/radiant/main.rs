@@ -1,5 +1,6 @@
 //! The `radiant` command line: a thin layer over the library.
 
+mod compare_cmd;
 mod lens_cmd;
 mod render_cmd;
 
@@ -16,6 +17,8 @@ struct Cli {
 enum Command {
     /// Render a scene (default: the built-in Cornell box).
     Render(render_cmd::RenderArgs),
+    /// Error metrics of a render against a reference image (B is the reference).
+    Compare(compare_cmd::CompareArgs),
     /// Inspect a realistic-camera lens file: paraxial data, focus, field of view, exit pupil.
     Lens(lens_cmd::LensArgs),
 }
@@ -24,6 +27,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(args),
+        Command::Compare(args) => compare_cmd::run(args),
         Command::Lens(args) => lens_cmd::run(args),
     };
     if let Err(e) = result {
