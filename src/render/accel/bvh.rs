@@ -3,14 +3,14 @@
 //! `Bvh` or `TriangleBvh` (see the instancing test below).
 
 use super::build::{BuildSettings, build_binary, collapse};
-use super::node::{Node4, NodeRay, decode_leaf, encode_leaf};
-use super::traverse;
+use super::node::{NodeRay, decode_leaf, encode_leaf};
+use super::traverse::{self, AnyLeaf, ClosestLeaf, LARGE_STACK, NodeTree, SMALL_STACK};
 use crate::render::geometry::{Aabb, Ray};
 
 /// A 4-wide BVH over caller-owned primitives given by their bounding boxes.
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
-    nodes: Vec<Node4>,
+    nodes: NodeTree,
     order: Vec<u32>,
     bounds: Aabb,
 }
@@ -32,7 +32,7 @@ impl Bvh {
         let Some(root) = root else {
             return Bvh::default();
         };
-        let nodes = collapse(&root, &mut encode_leaf);
+        let nodes = NodeTree::new(collapse(&root, &mut encode_leaf));
         let bounds = order
             .iter()
             .fold(Aabb::EMPTY, |b, &i| b.union(&prim_bounds[i as usize]));
@@ -52,40 +52,56 @@ impl Bvh {
         &self,
         ray: &Ray,
         t_max: f32,
-        mut intersect_prim: impl FnMut(u32, f32) -> Option<f32>,
+        intersect_prim: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<f32> {
-        let mut found = false;
-        let t = traverse::closest(&self.nodes, &NodeRay::new(ray), t_max, |leaf, t_max| {
-            let (start, count) = decode_leaf(leaf);
-            let mut t_max = t_max;
-            let mut hit = false;
-            for &prim in &self.order[start..start + count] {
-                if let Some(t) = intersect_prim(prim, t_max).filter(|&t| t < t_max) {
-                    t_max = t;
-                    hit = true;
-                }
-            }
-            found |= hit;
-            hit.then_some(t_max)
-        });
+        if self.nodes.shallow() {
+            self.closest_with::<SMALL_STACK>(ray, t_max, intersect_prim)
+        } else {
+            self.closest_with::<LARGE_STACK>(ray, t_max, intersect_prim)
+        }
+    }
+
+    #[inline(always)]
+    fn closest_with<const STACK: usize>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        intersect_prim: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Option<f32> {
+        let mut leaves = ClosestPrims {
+            order: &self.order,
+            intersect_prim,
+            found: false,
+        };
+        let t =
+            traverse::closest::<STACK>(self.nodes.nodes(), &NodeRay::new(ray), t_max, &mut leaves);
+        let found = leaves.found;
         found.then_some(t)
     }
 
     /// Any hit in (0, t_max): stops at the first primitive for which
     /// `occludes(prim_index, t_max)` returns true.
     #[inline]
-    pub fn any_hit(
+    pub fn any_hit(&self, ray: &Ray, t_max: f32, occludes: impl FnMut(u32, f32) -> bool) -> bool {
+        if self.nodes.shallow() {
+            self.any_with::<SMALL_STACK>(ray, t_max, occludes)
+        } else {
+            self.any_with::<LARGE_STACK>(ray, t_max, occludes)
+        }
+    }
+
+    #[inline(always)]
+    fn any_with<const STACK: usize>(
         &self,
         ray: &Ray,
         t_max: f32,
-        mut occludes: impl FnMut(u32, f32) -> bool,
+        occludes: impl FnMut(u32, f32) -> bool,
     ) -> bool {
-        traverse::any(&self.nodes, &NodeRay::new(ray), t_max, |leaf, t_max| {
-            let (start, count) = decode_leaf(leaf);
-            self.order[start..start + count]
-                .iter()
-                .any(|&prim| occludes(prim, t_max))
-        })
+        let mut leaves = AnyPrim {
+            order: &self.order,
+            occludes,
+        };
+        traverse::any::<STACK>(self.nodes.nodes(), &NodeRay::new(ray), t_max, &mut leaves)
     }
 
     /// The primitive indices in leaf order: `prim_order()[k]` is the primitive in the k-th
@@ -111,5 +127,42 @@ impl Bvh {
     /// Number of 4-wide nodes (for statistics).
     pub fn node_count(&self) -> usize {
         self.nodes.len()
+    }
+}
+
+struct ClosestPrims<'a, F> {
+    order: &'a [u32],
+    intersect_prim: F,
+    found: bool,
+}
+
+impl<F: FnMut(u32, f32) -> Option<f32>> ClosestLeaf for ClosestPrims<'_, F> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: u32, mut t_max: f32) -> Option<f32> {
+        let (start, count) = decode_leaf(leaf);
+        let mut hit = false;
+        for &prim in &self.order[start..start + count] {
+            if let Some(t) = (self.intersect_prim)(prim, t_max).filter(|&t| t < t_max) {
+                t_max = t;
+                hit = true;
+            }
+        }
+        self.found |= hit;
+        hit.then_some(t_max)
+    }
+}
+
+struct AnyPrim<'a, F> {
+    order: &'a [u32],
+    occludes: F,
+}
+
+impl<F: FnMut(u32, f32) -> bool> AnyLeaf for AnyPrim<'_, F> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: u32, t_max: f32) -> bool {
+        let (start, count) = decode_leaf(leaf);
+        self.order[start..start + count]
+            .iter()
+            .any(|&prim| (self.occludes)(prim, t_max))
     }
 }

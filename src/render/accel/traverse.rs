@@ -10,8 +10,66 @@ use super::build::MAX_DEPTH;
 use super::node::{LEAF_BIT, Node4, NodeRay};
 
 /// Each 4-wide level pushes at most three siblings and there are at most `MAX_DEPTH`
-/// levels, so this bounds the stack.
-const STACK_SIZE: usize = 3 * MAX_DEPTH as usize + 4;
+/// levels, so this bounds the stack of any tree.
+pub(crate) const LARGE_STACK: usize = 3 * MAX_DEPTH as usize + 4;
+/// The stack for trees of at most `SMALL_STACK_DEPTH` levels: typical trees are shallow,
+/// and zeroing the large stack for every ray costs measurably (~10 % on shadow rays).
+pub(crate) const SMALL_STACK: usize = 64;
+const SMALL_STACK_DEPTH: u32 = (SMALL_STACK as u32 - 1) / 3;
+
+/// The flattened 4-wide nodes (node 0 is the root) and whether the small stack suffices.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct NodeTree {
+    nodes: Vec<Node4>,
+    shallow: bool,
+}
+
+impl NodeTree {
+    pub fn new(nodes: Vec<Node4>) -> NodeTree {
+        // Children always follow their parent in the depth-first array, so one forward
+        // pass finds every node's level.
+        let mut level = vec![1u32; nodes.len()];
+        for i in 0..nodes.len() {
+            for &c in &nodes[i].child {
+                if c & LEAF_BIT == 0 {
+                    level[c as usize] = level[i] + 1;
+                }
+            }
+        }
+        let depth = level.iter().copied().max().unwrap_or(0);
+        NodeTree {
+            nodes,
+            shallow: depth <= SMALL_STACK_DEPTH,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    pub fn nodes(&self) -> &[Node4] {
+        &self.nodes
+    }
+
+    /// Whether [`SMALL_STACK`] entries suffice. Callers dispatch on this once per query to
+    /// a monomorphised traversal (doing it here would keep the leaf closures from inlining).
+    pub fn shallow(&self) -> bool {
+        self.shallow
+    }
+}
+
+/// What closest-hit traversal does at a leaf: intersect its primitives with hits closer
+/// than `t_max`, and return the new (smaller) `t_max` if there was one. A trait with
+/// `#[inline(always)]` implementations rather than a closure, because LLVM declines to
+/// inline a closure whose body (the SIMD triangle test) is large.
+pub(crate) trait ClosestLeaf {
+    fn visit(&mut self, leaf: u32, t_max: f32) -> Option<f32>;
+}
+
+/// What any-hit traversal does at a leaf: report whether it holds an occluder.
+pub(crate) trait AnyLeaf {
+    fn visit(&mut self, leaf: u32, t_max: f32) -> bool;
+}
 
 #[derive(Clone, Copy, Default)]
 struct Entry {
@@ -20,14 +78,14 @@ struct Entry {
 }
 
 /// Visits the leaves that may hold a hit closer than `t_max`, nearest first.
-/// `leaf(reference, t_max)` returns the new, smaller `t_max` when it found a hit.
+/// `leaf.visit(reference, t_max)` returns the new, smaller `t_max` when it found a hit.
 /// Returns the final `t_max`.
 #[inline(always)]
-pub(crate) fn closest(
+pub(crate) fn closest<const STACK_SIZE: usize>(
     nodes: &[Node4],
     ray: &NodeRay,
     mut t_max: f32,
-    mut leaf: impl FnMut(u32, f32) -> Option<f32>,
+    leaf: &mut impl ClosestLeaf,
 ) -> f32 {
     if nodes.is_empty() {
         return t_max;
@@ -97,7 +155,7 @@ pub(crate) fn closest(
                 cur = c[0].node;
                 continue;
             }
-        } else if let Some(t) = leaf(cur, t_max) {
+        } else if let Some(t) = leaf.visit(cur, t_max) {
             t_max = t;
         }
         // Pop the nearest pending subtree that can still hold a closer hit.
@@ -115,13 +173,13 @@ pub(crate) fn closest(
     }
 }
 
-/// Visits leaves until `leaf(reference, t_max)` reports an occluder; returns whether one did.
+/// Visits leaves until `leaf.visit(reference, t_max)` reports an occluder; returns whether one did.
 #[inline(always)]
-pub(crate) fn any(
+pub(crate) fn any<const STACK_SIZE: usize>(
     nodes: &[Node4],
     ray: &NodeRay,
     t_max: f32,
-    mut leaf: impl FnMut(u32, f32) -> bool,
+    leaf: &mut impl AnyLeaf,
 ) -> bool {
     if nodes.is_empty() {
         return false;
@@ -143,7 +201,7 @@ pub(crate) fn any(
                 }
                 continue;
             }
-        } else if leaf(cur, t_max) {
+        } else if leaf.visit(cur, t_max) {
             return true;
         }
         if sp == 0 {

@@ -3,8 +3,8 @@
 //! the hot path of the renderer.
 
 use super::build::{BuildSettings, build_binary, collapse};
-use super::node::{MAX_LEAF_ITEMS, Node4, NodeRay, decode_leaf, encode_leaf};
-use super::traverse;
+use super::node::{MAX_LEAF_ITEMS, NodeRay, decode_leaf, encode_leaf};
+use super::traverse::{self, AnyLeaf, ClosestLeaf, LARGE_STACK, NodeTree, SMALL_STACK};
 use super::triangle4::{Triangle4, WatertightRay4, intersect4};
 use crate::render::geometry::triangle::WatertightRay;
 use crate::render::geometry::{Aabb, Ray};
@@ -23,7 +23,7 @@ pub struct MeshHit {
 /// A BVH over triangles that owns a leaf-ordered copy of their vertices.
 #[derive(Clone, Debug, Default)]
 pub struct TriangleBvh {
-    nodes: Vec<Node4>,
+    nodes: NodeTree,
     packets: Vec<Triangle4>,
     order: Vec<u32>,
     bounds: Aabb,
@@ -60,7 +60,7 @@ impl TriangleBvh {
         };
         let mut packets = Vec::with_capacity(order.len() / 3);
         let mut tris = Vec::with_capacity(MAX_LEAF_ITEMS as usize);
-        let nodes = collapse(&root, &mut |start, count| {
+        let nodes = NodeTree::new(collapse(&root, &mut |start, count| {
             let first = packets.len() as u32;
             let prims = &order[start as usize..(start + count) as usize];
             for chunk in prims.chunks(4) {
@@ -74,7 +74,7 @@ impl TriangleBvh {
                 packets.push(Triangle4::new(&tris, chunk));
             }
             encode_leaf(first, packets.len() as u32 - first)
-        });
+        }));
         let bounds = order
             .iter()
             .fold(Aabb::EMPTY, |b, &i| b.union(&bounds[i as usize]));
@@ -98,56 +98,95 @@ impl TriangleBvh {
     /// Closest hit with 0 < t < t_max (watertight, two-sided).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<MeshHit> {
+        if self.nodes.shallow() {
+            self.intersect_with::<SMALL_STACK>(ray, t_max)
+        } else {
+            self.intersect_with::<LARGE_STACK>(ray, t_max)
+        }
+    }
+
+    #[inline(always)]
+    fn intersect_with<const STACK: usize>(&self, ray: &Ray, t_max: f32) -> Option<MeshHit> {
         let wr = WatertightRay4::new(&WatertightRay::new(ray));
         let mut best: Option<MeshHit> = None;
-        traverse::closest(&self.nodes, &NodeRay::new(ray), t_max, |leaf, t_max| {
-            let (start, count) = decode_leaf(leaf);
-            let mut t_max = t_max;
-            let mut hit = false;
-            for packet in &self.packets[start..start + count] {
-                let lanes = intersect4(&wr, packet, t_max);
-                if lanes.hit == 0 {
-                    continue;
-                }
-                let t = lanes.t.to_array();
-                let mut lane = lanes.hit.trailing_zeros() as usize;
-                let mut rest = lanes.hit & (lanes.hit - 1);
-                while rest != 0 {
-                    let l = rest.trailing_zeros() as usize;
-                    if t[l & 3] < t[lane & 3] {
-                        lane = l;
-                    }
-                    rest &= rest - 1;
-                }
-                let lane = lane & 3;
-                let inv = lanes.inv_det[lane];
-                t_max = t[lane];
-                hit = true;
-                best = Some(MeshHit {
-                    t: t_max,
-                    prim: packet.prim[lane],
-                    b: [
-                        lanes.u[lane] * inv,
-                        lanes.v[lane] * inv,
-                        lanes.w[lane] * inv,
-                    ],
-                });
-            }
-            hit.then_some(t_max)
-        });
+        let mut leaves = ClosestBlocks {
+            bvh: self,
+            ray: &wr,
+            best: &mut best,
+        };
+        traverse::closest::<STACK>(self.nodes.nodes(), &NodeRay::new(ray), t_max, &mut leaves);
         best
+    }
+
+    /// Intersects a leaf's blocks; records a closer hit in `best` and returns its distance.
+    #[inline(always)]
+    fn leaf_closest(
+        &self,
+        wr: &WatertightRay4,
+        leaf: u32,
+        mut t_max: f32,
+        best: &mut Option<MeshHit>,
+    ) -> Option<f32> {
+        let (start, count) = decode_leaf(leaf);
+        let mut hit = false;
+        for packet in &self.packets[start..start + count] {
+            let lanes = intersect4(wr, packet, t_max);
+            if lanes.hit == 0 {
+                continue;
+            }
+            let t = lanes.t.to_array();
+            let mut lane = lanes.hit.trailing_zeros() as usize;
+            let mut rest = lanes.hit & (lanes.hit - 1);
+            while rest != 0 {
+                let l = rest.trailing_zeros() as usize;
+                if t[l & 3] < t[lane & 3] {
+                    lane = l;
+                }
+                rest &= rest - 1;
+            }
+            let lane = lane & 3;
+            let inv = lanes.inv_det[lane];
+            t_max = t[lane];
+            hit = true;
+            *best = Some(MeshHit {
+                t: t_max,
+                prim: packet.prim[lane],
+                b: [
+                    lanes.u[lane] * inv,
+                    lanes.v[lane] * inv,
+                    lanes.w[lane] * inv,
+                ],
+            });
+        }
+        hit.then_some(t_max)
+    }
+
+    #[inline(always)]
+    fn leaf_occluded(&self, wr: &WatertightRay4, leaf: u32, t_max: f32) -> bool {
+        let (start, count) = decode_leaf(leaf);
+        self.packets[start..start + count]
+            .iter()
+            .any(|p| intersect4(wr, p, t_max).hit != 0)
     }
 
     /// Whether anything is hit with 0 < t < t_max.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        if self.nodes.shallow() {
+            self.occluded_with::<SMALL_STACK>(ray, t_max)
+        } else {
+            self.occluded_with::<LARGE_STACK>(ray, t_max)
+        }
+    }
+
+    #[inline(always)]
+    fn occluded_with<const STACK: usize>(&self, ray: &Ray, t_max: f32) -> bool {
         let wr = WatertightRay4::new(&WatertightRay::new(ray));
-        traverse::any(&self.nodes, &NodeRay::new(ray), t_max, |leaf, t_max| {
-            let (start, count) = decode_leaf(leaf);
-            self.packets[start..start + count]
-                .iter()
-                .any(|p| intersect4(&wr, p, t_max).hit != 0)
-        })
+        let mut leaves = AnyBlock {
+            bvh: self,
+            ray: &wr,
+        };
+        traverse::any::<STACK>(self.nodes.nodes(), &NodeRay::new(ray), t_max, &mut leaves)
     }
 
     /// Triangle indices in leaf order (see [`Bvh::prim_order`](super::Bvh::prim_order)).
@@ -167,5 +206,30 @@ impl TriangleBvh {
     /// (4-wide nodes, 4-triangle blocks), for statistics.
     pub fn size(&self) -> (usize, usize) {
         (self.nodes.len(), self.packets.len())
+    }
+}
+
+struct ClosestBlocks<'a> {
+    bvh: &'a TriangleBvh,
+    ray: &'a WatertightRay4,
+    best: &'a mut Option<MeshHit>,
+}
+
+impl ClosestLeaf for ClosestBlocks<'_> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: u32, t_max: f32) -> Option<f32> {
+        self.bvh.leaf_closest(self.ray, leaf, t_max, self.best)
+    }
+}
+
+struct AnyBlock<'a> {
+    bvh: &'a TriangleBvh,
+    ray: &'a WatertightRay4,
+}
+
+impl AnyLeaf for AnyBlock<'_> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: u32, t_max: f32) -> bool {
+        self.bvh.leaf_occluded(self.ray, leaf, t_max)
     }
 }
