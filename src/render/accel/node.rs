@@ -55,10 +55,11 @@ impl Node4 {
     }
 }
 
-/// 1 + 2γ(3) with γ(n) = nε / (1 − nε), ε = 2⁻²⁴: scaling the exit distance by it makes the
-/// slab test conservative under f32 round-off (Ize, "Robust BVH Ray Traversal", JCGT 2013),
-/// so the box test never culls a hit the watertight triangle test would report.
-const ROBUST_EXIT_SCALE: f32 = 1.000_000_4;
+/// 1 + 2γ(3) with γ(n) = nε / (1 − nε), ε = 2⁻²⁴: padding the reciprocal direction used for
+/// the exit planes by it makes the slab test conservative under f32 round-off (Ize, "Robust
+/// BVH Ray Traversal", JCGT 2013), so the box test never culls a hit the watertight triangle
+/// test would report.
+pub(crate) const ROBUST_EXIT_SCALE: f32 = 1.000_000_4;
 
 /// Per-ray constants of the four-box slab test (Kay & Kajiya 1986; Williams et al., "An
 /// Efficient and Robust Ray-Box Intersection Algorithm", JGT 2005): the reciprocal
@@ -67,6 +68,8 @@ const ROBUST_EXIT_SCALE: f32 = 1.000_000_4;
 pub(crate) struct NodeRay {
     o: [Vec4; 3],
     inv: [Vec4; 3],
+    /// `inv` padded by [`ROBUST_EXIT_SCALE`], for the exit planes.
+    inv_exit: [Vec4; 3],
     near: [usize; 3],
 }
 
@@ -81,6 +84,7 @@ impl NodeRay {
                 Vec4::splat(ray.o.z),
             ],
             inv: inv.map(Vec4::splat),
+            inv_exit: inv.map(|v| Vec4::splat(v * ROBUST_EXIT_SCALE)),
             near: inv.map(|v| usize::from(v < 0.0)),
         }
     }
@@ -90,19 +94,21 @@ impl NodeRay {
     #[inline(always)]
     pub fn hit(&self, node: &Node4, t_max: f32) -> (u32, Vec4) {
         let mut t_in = Vec4::ZERO;
-        let mut t_out = Vec4::splat(t_max);
+        // The computed entry distance may exceed the true one by the same round-off, so
+        // the limit is padded too: a box entered just before t_max is never culled.
+        let mut t_out = Vec4::splat(t_max * ROBUST_EXIT_SCALE);
         for axis in 0..3 {
             let s = self.near[axis] & 1;
             let planes = &node.bounds[axis];
             let t0 = (planes[s] - self.o[axis]) * self.inv[axis];
-            let t1 = (planes[s ^ 1] - self.o[axis]) * self.inv[axis];
+            let t1 = (planes[s ^ 1] - self.o[axis]) * self.inv_exit[axis];
             // A zero direction component gives inv = ±∞, and a ray starting exactly on a
             // slab plane then gives 0 · ∞ = NaN. The operand order makes the NaN drop out
             // (SSE min/max return the second operand when either is NaN, and f32::min/max
             // ignore NaN), which treats the ray as inside that slab: correct, as it lies
             // on the plane.
             t_in = t0.max(t_in);
-            t_out = (t1 * ROBUST_EXIT_SCALE).min(t_out);
+            t_out = t1.min(t_out);
         }
         (t_in.cmple(t_out).bitmask(), t_in)
     }

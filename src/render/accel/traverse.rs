@@ -7,7 +7,7 @@
 //! distance so that it is skipped when popped if a closer hit has been found since.
 
 use super::build::MAX_DEPTH;
-use super::node::{LEAF_BIT, Node4, NodeRay};
+use super::node::{LEAF_BIT, Node4, NodeRay, ROBUST_EXIT_SCALE};
 
 /// Each 4-wide level pushes at most three siblings and there are at most `MAX_DEPTH`
 /// levels, so this bounds the stack of any tree.
@@ -64,11 +64,33 @@ impl NodeTree {
 /// inline a closure whose body (the SIMD triangle test) is large.
 pub(crate) trait ClosestLeaf {
     fn visit(&mut self, leaf: u32, t_max: f32) -> Option<f32>;
+    /// Loads the leaf's first data early (a software prefetch in safe Rust).
+    fn touch(&self, _leaf: u32) {}
+}
+
+/// Starts loading every entered child's data at once, so that their cache misses overlap
+/// instead of being taken one after another when each is visited.
+#[inline(always)]
+fn touch_children(nodes: &[Node4], node: &Node4, mut mask: u32, touch_leaf: impl Fn(u32)) {
+    while mask != 0 {
+        let c = node.child[mask.trailing_zeros() as usize & 3];
+        mask &= mask - 1;
+        if c & LEAF_BIT == 0 {
+            if let Some(n) = nodes.get(c as usize) {
+                std::hint::black_box(n.bounds[0][0].x);
+                std::hint::black_box(n.child[0]);
+            }
+        } else {
+            touch_leaf(c);
+        }
+    }
 }
 
 /// What any-hit traversal does at a leaf: report whether it holds an occluder.
 pub(crate) trait AnyLeaf {
     fn visit(&mut self, leaf: u32, t_max: f32) -> bool;
+    /// Loads the leaf's first data early (a software prefetch in safe Rust).
+    fn touch(&self, _leaf: u32) {}
 }
 
 #[derive(Clone, Copy, Default)]
@@ -98,6 +120,7 @@ pub(crate) fn closest<const STACK_SIZE: usize>(
             let node = &nodes[cur as usize];
             let (mut mask, t_in) = ray.hit(node, t_max);
             if mask != 0 {
+                touch_children(nodes, node, mask, |c| leaf.touch(c));
                 let t_in = t_in.to_array();
                 let i0 = mask.trailing_zeros() as usize & 3;
                 mask &= mask - 1;
@@ -165,7 +188,8 @@ pub(crate) fn closest<const STACK_SIZE: usize>(
             }
             sp -= 1;
             let e = stack[sp];
-            if e.t_in <= t_max {
+            // Padded like the box test: t_in may be rounded up by a few ulps.
+            if e.t_in <= t_max * ROBUST_EXIT_SCALE {
                 cur = e.node;
                 break;
             }
@@ -192,6 +216,7 @@ pub(crate) fn any<const STACK_SIZE: usize>(
             let node = &nodes[cur as usize];
             let (mut mask, _) = ray.hit(node, t_max);
             if mask != 0 {
+                touch_children(nodes, node, mask, |c| leaf.touch(c));
                 cur = node.child[mask.trailing_zeros() as usize & 3];
                 mask &= mask - 1;
                 while mask != 0 {

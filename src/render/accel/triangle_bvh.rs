@@ -145,7 +145,7 @@ impl TriangleBvh {
                 rest &= rest - 1;
             }
             let lane = lane & 3;
-            let inv = lanes.inv_det[lane];
+            let inv = 1.0 / lanes.det[lane];
             t_max = t[lane];
             hit = true;
             *best = Some(MeshHit {
@@ -159,6 +159,16 @@ impl TriangleBvh {
             });
         }
         hit.then_some(t_max)
+    }
+
+    #[inline(always)]
+    fn touch_leaf(&self, leaf: u32) {
+        let (start, _) = decode_leaf(leaf);
+        if let Some(p) = self.packets.get(start) {
+            std::hint::black_box(p.v[0][0].x);
+            std::hint::black_box(p.v[1][2].x);
+            std::hint::black_box(p.prim[0]);
+        }
     }
 
     #[inline(always)]
@@ -220,6 +230,11 @@ impl ClosestLeaf for ClosestBlocks<'_> {
     fn visit(&mut self, leaf: u32, t_max: f32) -> Option<f32> {
         self.bvh.leaf_closest(self.ray, leaf, t_max, self.best)
     }
+
+    #[inline(always)]
+    fn touch(&self, leaf: u32) {
+        self.bvh.touch_leaf(leaf);
+    }
 }
 
 struct AnyBlock<'a> {
@@ -231,5 +246,10 @@ impl AnyLeaf for AnyBlock<'_> {
     #[inline(always)]
     fn visit(&mut self, leaf: u32, t_max: f32) -> bool {
         self.bvh.leaf_occluded(self.ray, leaf, t_max)
+    }
+
+    #[inline(always)]
+    fn touch(&self, leaf: u32) {
+        self.bvh.touch_leaf(leaf);
     }
 }
