@@ -9,21 +9,21 @@
 use crate::render::geometry::triangle::{WatertightRay, edge_functions_f64};
 use glam::{BVec4A, Vec3, Vec4};
 
-/// Four triangles, vertex coordinates by lane: `v[vertex][axis]`. Unused lanes repeat a
-/// triangle of the same leaf, which changes no result.
+/// Four triangles, vertex coordinates by lane: `v[vertex][axis]` (144 bytes; the triangle
+/// indices live in a parallel array, read once per query for the final hit). Unused lanes
+/// repeat a triangle of the same leaf, which changes no result.
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(32))]
 pub(crate) struct Triangle4 {
     pub v: [[Vec4; 3]; 3],
-    pub prim: [u32; 4],
 }
 
 impl Triangle4 {
-    pub fn new(tris: &[[Vec3; 3]], prims: &[u32]) -> Triangle4 {
+    /// Packs up to four triangles; returns the block and the triangle index of each lane.
+    pub fn new(tris: &[[Vec3; 3]], prims: &[u32]) -> (Triangle4, [u32; 4]) {
         let mut t = Triangle4 {
             v: [[Vec4::ZERO; 3]; 3],
-            prim: [0; 4],
         };
+        let mut lanes = [0; 4];
         let last = tris.len() - 1;
         for lane in 0..4 {
             let k = lane.min(last);
@@ -32,9 +32,9 @@ impl Triangle4 {
                     t.v[vertex][axis][lane] = p[axis];
                 }
             }
-            t.prim[lane] = prims[k];
+            lanes[lane] = prims[k];
         }
-        t
+        (t, lanes)
     }
 }
 

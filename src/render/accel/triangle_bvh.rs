@@ -25,6 +25,8 @@ pub struct MeshHit {
 pub struct TriangleBvh {
     nodes: NodeTree,
     packets: Vec<Triangle4>,
+    /// Triangle index of each lane of each block.
+    packet_prims: Vec<[u32; 4]>,
     order: Vec<u32>,
     bounds: Aabb,
 }
@@ -59,6 +61,7 @@ impl TriangleBvh {
             return TriangleBvh::default();
         };
         let mut packets = Vec::with_capacity(order.len() / 3);
+        let mut packet_prims = Vec::with_capacity(order.len() / 3);
         let mut tris = Vec::with_capacity(MAX_LEAF_ITEMS as usize);
         let nodes = NodeTree::new(collapse(&root, &mut |start, count| {
             let first = packets.len() as u32;
@@ -71,7 +74,9 @@ impl TriangleBvh {
                         .iter()
                         .filter_map(|&i| corners(&triangles[i as usize])),
                 );
-                packets.push(Triangle4::new(&tris, chunk));
+                let (block, lanes) = Triangle4::new(&tris, chunk);
+                packets.push(block);
+                packet_prims.push(lanes);
             }
             encode_leaf(first, packets.len() as u32 - first)
         }));
@@ -81,6 +86,7 @@ impl TriangleBvh {
         TriangleBvh {
             nodes,
             packets,
+            packet_prims,
             order,
             bounds,
         }
@@ -108,14 +114,18 @@ impl TriangleBvh {
     #[inline(always)]
     fn intersect_with<const STACK: usize>(&self, ray: &Ray, t_max: f32) -> Option<MeshHit> {
         let wr = WatertightRay4::new(&WatertightRay::new(ray));
-        let mut best: Option<MeshHit> = None;
+        let mut best: Option<BlockHit> = None;
         let mut leaves = ClosestBlocks {
             bvh: self,
             ray: &wr,
             best: &mut best,
         };
         traverse::closest::<STACK>(self.nodes.nodes(), &NodeRay::new(ray), t_max, &mut leaves);
-        best
+        best.map(|h| MeshHit {
+            t: h.t,
+            prim: self.packet_prims[h.block as usize][h.lane as usize & 3],
+            b: h.b,
+        })
     }
 
     /// Intersects a leaf's blocks; records a closer hit in `best` and returns its distance.
@@ -125,11 +135,11 @@ impl TriangleBvh {
         wr: &WatertightRay4,
         leaf: u32,
         mut t_max: f32,
-        best: &mut Option<MeshHit>,
+        best: &mut Option<BlockHit>,
     ) -> Option<f32> {
         let (start, count) = decode_leaf(leaf);
         let mut hit = false;
-        for packet in &self.packets[start..start + count] {
+        for (block, packet) in self.packets[start..start + count].iter().enumerate() {
             let lanes = intersect4(wr, packet, t_max);
             if lanes.hit == 0 {
                 continue;
@@ -148,9 +158,10 @@ impl TriangleBvh {
             let inv = 1.0 / lanes.det[lane];
             t_max = t[lane];
             hit = true;
-            *best = Some(MeshHit {
+            *best = Some(BlockHit {
                 t: t_max,
-                prim: packet.prim[lane],
+                block: (start + block) as u32,
+                lane: lane as u32,
                 b: [
                     lanes.u[lane] * inv,
                     lanes.v[lane] * inv,
@@ -165,9 +176,10 @@ impl TriangleBvh {
     fn touch_leaf(&self, leaf: u32) {
         let (start, _) = decode_leaf(leaf);
         if let Some(p) = self.packets.get(start) {
+            // One word in each cache line a 144-byte block can span.
             std::hint::black_box(p.v[0][0].x);
-            std::hint::black_box(p.v[1][2].x);
-            std::hint::black_box(p.prim[0]);
+            std::hint::black_box(p.v[1][1].x);
+            std::hint::black_box(p.v[2][2].w);
         }
     }
 
@@ -219,10 +231,19 @@ impl TriangleBvh {
     }
 }
 
+/// The closest hit so far, by block and lane (the triangle index is looked up once, at the end).
+#[derive(Clone, Copy)]
+struct BlockHit {
+    t: f32,
+    block: u32,
+    lane: u32,
+    b: [f32; 3],
+}
+
 struct ClosestBlocks<'a> {
     bvh: &'a TriangleBvh,
     ray: &'a WatertightRay4,
-    best: &'a mut Option<MeshHit>,
+    best: &'a mut Option<BlockHit>,
 }
 
 impl ClosestLeaf for ClosestBlocks<'_> {
