@@ -9,7 +9,7 @@
 //! opening the child with the largest surface area (as in Wald et al., "Getting Rid of
 //! Packets", IEEE RT 2008, and Embree's BVH4), and flattened depth-first.
 
-use super::node::Node4;
+use super::node::{Node4, WIDTH};
 use crate::render::geometry::Aabb;
 use glam::Vec3;
 
@@ -338,7 +338,7 @@ fn emit(
         unreachable!("emit is only called on inner nodes");
     };
     let mut slots: Vec<&BuildNode> = children.iter().collect();
-    while slots.len() < 4 {
+    while slots.len() < WIDTH {
         // Open the inner child with the largest surface area.
         let widest = slots
             .iter()

@@ -1,4 +1,4 @@
-//! Stack-based traversal of the 4-wide node array, shared by the generic and the
+//! Stack-based traversal of the wide node array, shared by the generic and the
 //! triangle BVH. Leaves are handed to a closure; the closures are monomorphised and
 //! inlined, so the triangle path pays no indirection.
 //!
@@ -7,17 +7,17 @@
 //! distance so that it is skipped when popped if a closer hit has been found since.
 
 use super::build::MAX_DEPTH;
-use super::node::{LEAF_BIT, Node4, NodeRay, ROBUST_EXIT_SCALE};
+use super::node::{LEAF_BIT, Node4, NodeRay, ROBUST_EXIT_SCALE, WIDTH};
 
-/// Each 4-wide level pushes at most three siblings and there are at most `MAX_DEPTH`
+/// Each level pushes at most `WIDTH − 1` siblings and there are at most `MAX_DEPTH`
 /// levels, so this bounds the stack of any tree.
-pub(crate) const LARGE_STACK: usize = 3 * MAX_DEPTH as usize + 4;
+pub(crate) const LARGE_STACK: usize = (WIDTH - 1) * MAX_DEPTH as usize + 4;
 /// The stack for trees of at most `SMALL_STACK_DEPTH` levels: typical trees are shallow,
 /// and zeroing the large stack for every ray costs measurably (~10 % on shadow rays).
-pub(crate) const SMALL_STACK: usize = 64;
-const SMALL_STACK_DEPTH: u32 = (SMALL_STACK as u32 - 1) / 3;
+pub(crate) const SMALL_STACK: usize = 96;
+const SMALL_STACK_DEPTH: u32 = (SMALL_STACK as u32 - 1) / (WIDTH as u32 - 1);
 
-/// The flattened 4-wide nodes (node 0 is the root) and whether the small stack suffices.
+/// The flattened wide nodes (node 0 is the root) and whether the small stack suffices.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct NodeTree {
     nodes: Vec<Node4>,
@@ -73,11 +73,14 @@ pub(crate) trait ClosestLeaf {
 #[inline(always)]
 fn touch_children(nodes: &[Node4], node: &Node4, mut mask: u32, touch_leaf: impl Fn(u32)) {
     while mask != 0 {
-        let c = node.child[mask.trailing_zeros() as usize & 3];
+        let c = node.child[mask.trailing_zeros() as usize % WIDTH];
         mask &= mask - 1;
         if c & LEAF_BIT == 0 {
             if let Some(n) = nodes.get(c as usize) {
-                std::hint::black_box(n.bounds[0][0].x);
+                // A word in each cache line of the node (each axis, then the children).
+                for axis in &n.bounds {
+                    std::hint::black_box(axis[0][0].x);
+                }
                 std::hint::black_box(n.child[0]);
             }
         } else {
@@ -121,61 +124,61 @@ pub(crate) fn closest<const STACK_SIZE: usize>(
             let (mut mask, t_in) = ray.hit(node, t_max);
             if mask != 0 {
                 touch_children(nodes, node, mask, |c| leaf.touch(c));
-                let t_in = t_in.to_array();
-                let i0 = mask.trailing_zeros() as usize & 3;
+                let mut t = [0.0f32; WIDTH];
+                for (g, v) in t_in.iter().enumerate() {
+                    t[4 * g..4 * g + 4].copy_from_slice(&v.to_array());
+                }
+                let i0 = mask.trailing_zeros() as usize % WIDTH;
                 mask &= mask - 1;
                 if mask == 0 {
                     cur = node.child[i0];
                     continue;
                 }
-                let i1 = mask.trailing_zeros() as usize & 3;
+                let i1 = mask.trailing_zeros() as usize % WIDTH;
                 mask &= mask - 1;
                 if mask == 0 {
-                    let (near, far) = if t_in[i0] <= t_in[i1] {
-                        (i0, i1)
-                    } else {
-                        (i1, i0)
-                    };
+                    let (near, far) = if t[i0] <= t[i1] { (i0, i1) } else { (i1, i0) };
                     stack[sp] = Entry {
                         node: node.child[far],
-                        t_in: t_in[far],
+                        t_in: t[far],
                     };
                     sp += 1;
                     cur = node.child[near];
                     continue;
                 }
-                // Three or four children: sort by entry distance (insertion sort).
-                let mut c = [Entry::default(); 4];
-                c[0] = Entry {
-                    node: node.child[i0],
-                    t_in: t_in[i0],
-                };
-                c[1] = Entry {
-                    node: node.child[i1],
-                    t_in: t_in[i1],
-                };
-                let mut k = 2;
-                while mask != 0 {
-                    let i = mask.trailing_zeros() as usize & 3;
-                    mask &= mask - 1;
-                    c[k & 3] = Entry {
+                // Three or more children: sort by entry distance (insertion sort), nearest
+                // last, and push all but the nearest.
+                let mut c = [Entry::default(); WIDTH];
+                let mut k = 0;
+                for i in [i0, i1] {
+                    c[k] = Entry {
                         node: node.child[i],
-                        t_in: t_in[i],
+                        t_in: t[i],
                     };
                     k += 1;
                 }
-                for i in 1..k.min(4) {
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize % WIDTH;
+                    mask &= mask - 1;
+                    c[k % WIDTH] = Entry {
+                        node: node.child[i],
+                        t_in: t[i],
+                    };
+                    k += 1;
+                }
+                let k = k.min(WIDTH);
+                for i in 1..k {
                     let mut j = i;
-                    while j > 0 && c[j - 1].t_in > c[j].t_in {
+                    while j > 0 && c[j - 1].t_in < c[j].t_in {
                         c.swap(j - 1, j);
                         j -= 1;
                     }
                 }
-                for e in c[1..k.min(4)].iter().rev() {
+                for e in &c[..k - 1] {
                     stack[sp] = *e;
                     sp += 1;
                 }
-                cur = c[0].node;
+                cur = c[k - 1].node;
                 continue;
             }
         } else if let Some(t) = leaf.visit(cur, t_max) {
@@ -217,10 +220,10 @@ pub(crate) fn any<const STACK_SIZE: usize>(
             let (mut mask, _) = ray.hit(node, t_max);
             if mask != 0 {
                 touch_children(nodes, node, mask, |c| leaf.touch(c));
-                cur = node.child[mask.trailing_zeros() as usize & 3];
+                cur = node.child[mask.trailing_zeros() as usize % WIDTH];
                 mask &= mask - 1;
                 while mask != 0 {
-                    stack[sp] = node.child[mask.trailing_zeros() as usize & 3];
+                    stack[sp] = node.child[mask.trailing_zeros() as usize % WIDTH];
                     sp += 1;
                     mask &= mask - 1;
                 }
