@@ -306,40 +306,36 @@ fn build_range(refs: &mut [PrimRef], offset: u32, depth: u32, s: &BuildSettings)
     }
 }
 
-/// Collapses the binary tree into 4-wide nodes, flattened depth-first (node 0 is the
-/// root). `leaf_ref` turns a leaf's range of the leaf order into an encoded child
-/// reference (so the triangle BVH can repack leaves into SIMD blocks).
+/// Collapses the binary tree into `WIDTH`-wide nodes (node 0 is the root). `leaf_ref`
+/// turns a leaf's range of the leaf order into an encoded child reference (so the triangle
+/// BVH can repack leaves into SIMD blocks).
+///
+/// Layout: the inner children of a node get consecutive slots, and its leaves' data is
+/// packed together before any deeper level's, so that what one node visit touches lies
+/// close together in memory (as in Ylitie et al., "Efficient Incoherent Ray Traversal on
+/// GPUs Through Compressed Wide BVHs", HPG 2017). Parents precede their children.
 pub(crate) fn collapse(root: &BuildNode, leaf_ref: &mut impl FnMut(u32, u32) -> u32) -> Vec<Node4> {
-    let mut nodes = Vec::new();
+    let mut nodes = vec![Node4::empty()];
     match root {
         BuildNode::Leaf {
             bounds,
             start,
             count,
-        } => {
-            let mut node = Node4::empty();
-            node.set_child(0, bounds, leaf_ref(*start, *count));
-            nodes.push(node);
-        }
-        BuildNode::Inner { .. } => {
-            emit(root, &mut nodes, leaf_ref);
-        }
+        } => nodes[0].set_child(0, bounds, leaf_ref(*start, *count)),
+        BuildNode::Inner { .. } => fill(root, 0, &mut nodes, leaf_ref),
     }
     nodes
 }
 
-/// Emits the 4-wide node for binary inner node `node` and its subtree; returns its index.
-fn emit(
-    node: &BuildNode,
-    nodes: &mut Vec<Node4>,
-    leaf_ref: &mut impl FnMut(u32, u32) -> u32,
-) -> u32 {
+/// The up-to-`WIDTH` binary-tree nodes that become the children of the wide node for
+/// inner node `node`: its two children, then repeatedly the inner child with the largest
+/// surface area replaced by its own two children.
+fn wide_children(node: &BuildNode) -> Vec<&BuildNode> {
     let BuildNode::Inner { children, .. } = node else {
-        unreachable!("emit is only called on inner nodes");
+        return vec![node];
     };
     let mut slots: Vec<&BuildNode> = children.iter().collect();
     while slots.len() < WIDTH {
-        // Open the inner child with the largest surface area.
         let widest = slots
             .iter()
             .enumerate()
@@ -352,18 +348,35 @@ fn emit(
             .map(|(i, _)| i);
         let Some(i) = widest else { break };
         let BuildNode::Inner { children, .. } = slots.swap_remove(i) else {
-            unreachable!()
+            unreachable!("only inner nodes are opened")
         };
         slots.extend(children.iter());
     }
-    let index = nodes.len();
-    nodes.push(Node4::empty());
+    slots
+}
+
+/// Fills the already allocated wide node `index` for binary inner node `node`, then its
+/// subtree.
+fn fill(
+    node: &BuildNode,
+    index: usize,
+    nodes: &mut Vec<Node4>,
+    leaf_ref: &mut impl FnMut(u32, u32) -> u32,
+) {
+    let slots = wide_children(node);
+    let mut inner = Vec::with_capacity(WIDTH);
     for (k, child) in slots.iter().enumerate() {
         let r = match child {
             BuildNode::Leaf { start, count, .. } => leaf_ref(*start, *count),
-            BuildNode::Inner { .. } => emit(child, nodes, leaf_ref),
+            BuildNode::Inner { .. } => {
+                nodes.push(Node4::empty());
+                inner.push((nodes.len() - 1, *child));
+                (nodes.len() - 1) as u32
+            }
         };
         nodes[index].set_child(k, child.bounds(), r);
     }
-    index as u32
+    for (i, child) in inner {
+        fill(child, i, nodes, leaf_ref);
+    }
 }
