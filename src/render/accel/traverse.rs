@@ -217,17 +217,14 @@ pub(crate) fn any<const STACK_SIZE: usize>(
     loop {
         if cur & LEAF_BIT == 0 {
             let node = &nodes[cur as usize];
-            let (mut mask, _) = ray.hit(node, t_max);
+            let (mask, _) = ray.hit(node, t_max);
             if mask != 0 {
                 touch_children(nodes, node, mask, |c| leaf.touch(c));
-                cur = node.child[mask.trailing_zeros() as usize % WIDTH];
-                mask &= mask - 1;
-                while mask != 0 {
-                    stack[sp] = node.child[mask.trailing_zeros() as usize % WIDTH];
-                    sp += 1;
-                    mask &= mask - 1;
+                // Branch-free compaction: every child is written, only entered ones count.
+                for (i, &c) in node.child.iter().enumerate() {
+                    stack[sp.min(STACK_SIZE - 1)] = c;
+                    sp += ((mask >> i) & 1) as usize;
                 }
-                continue;
             }
         } else if leaf.visit(cur, t_max) {
             return true;
