@@ -1,15 +1,15 @@
-//! Binned SAH construction of a binary BVH, then collapse into a 4-wide node array.
+//! Binned SAH construction of a binary BVH, then collapse into a wide (8-child) node array.
 //!
 //! The binary build follows Wald, "On fast Construction of SAH-based Bounding Volume
 //! Hierarchies" (IEEE RT 2007): primitive centroids are binned into a fixed number of
 //! buckets per axis, the surface area heuristic (Goldsmith & Salmon 1987; MacDonald &
 //! Booth 1990) is evaluated at every bucket boundary, and the primitive references are
 //! partitioned in place. Large ranges are binned in parallel and subtrees built with
-//! `rayon::join`. The binary tree is then collapsed into 4-wide nodes by repeatedly
+//! `rayon::join`. The binary tree is then collapsed into wide nodes by repeatedly
 //! opening the child with the largest surface area (as in Wald et al., "Getting Rid of
 //! Packets", IEEE RT 2008, and Embree's BVH4), and flattened depth-first.
 
-use super::node::{Node4, WIDTH};
+use super::node::{WIDTH, WideNode};
 use crate::render::geometry::Aabb;
 use glam::Vec3;
 
@@ -314,8 +314,11 @@ fn build_range(refs: &mut [PrimRef], offset: u32, depth: u32, s: &BuildSettings)
 /// packed together before any deeper level's, so that what one node visit touches lies
 /// close together in memory (as in Ylitie et al., "Efficient Incoherent Ray Traversal on
 /// GPUs Through Compressed Wide BVHs", HPG 2017). Parents precede their children.
-pub(crate) fn collapse(root: &BuildNode, leaf_ref: &mut impl FnMut(u32, u32) -> u32) -> Vec<Node4> {
-    let mut nodes = vec![Node4::empty()];
+pub(crate) fn collapse(
+    root: &BuildNode,
+    leaf_ref: &mut impl FnMut(u32, u32) -> u32,
+) -> Vec<WideNode> {
+    let mut nodes = vec![WideNode::empty()];
     match root {
         BuildNode::Leaf {
             bounds,
@@ -360,7 +363,7 @@ fn wide_children(node: &BuildNode) -> Vec<&BuildNode> {
 fn fill(
     node: &BuildNode,
     index: usize,
-    nodes: &mut Vec<Node4>,
+    nodes: &mut Vec<WideNode>,
     leaf_ref: &mut impl FnMut(u32, u32) -> u32,
 ) {
     let slots = wide_children(node);
@@ -369,7 +372,7 @@ fn fill(
         let r = match child {
             BuildNode::Leaf { start, count, .. } => leaf_ref(*start, *count),
             BuildNode::Inner { .. } => {
-                nodes.push(Node4::empty());
+                nodes.push(WideNode::empty());
                 inner.push((nodes.len() - 1, *child));
                 (nodes.len() - 1) as u32
             }

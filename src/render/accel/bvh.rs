@@ -7,7 +7,7 @@ use super::node::{NodeRay, decode_leaf, encode_leaf};
 use super::traverse::{self, AnyLeaf, ClosestLeaf, LARGE_STACK, NodeTree, SMALL_STACK};
 use crate::render::geometry::{Aabb, Ray};
 
-/// A 4-wide BVH over caller-owned primitives given by their bounding boxes.
+/// An 8-wide BVH over caller-owned primitives given by their bounding boxes.
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
     nodes: NodeTree,
@@ -24,8 +24,8 @@ const SETTINGS: BuildSettings = BuildSettings {
 };
 
 impl Bvh {
-    /// Binned SAH build (Wald 2007), parallel with rayon for large inputs, collapsed to a
-    /// 4-wide node array flattened depth-first. Primitives whose box is empty or not
+    /// Binned SAH build (Wald 2007), parallel with rayon for large inputs, collapsed to an
+    /// 8-wide node array. Primitives whose box is empty or not
     /// finite can never be hit and are left out.
     pub fn build(prim_bounds: &[Aabb]) -> Bvh {
         let (root, order) = build_binary(prim_bounds, &SETTINGS);
@@ -124,9 +124,28 @@ impl Bvh {
         self.bounds
     }
 
-    /// Number of 4-wide nodes (for statistics).
+    /// Number of wide nodes (for statistics).
     pub fn node_count(&self) -> usize {
         self.nodes.len()
+    }
+
+    #[cfg(test)]
+    pub(crate) fn nodes_are_shallow(&self) -> bool {
+        self.nodes.shallow()
+    }
+
+    /// A tree from hand-made nodes (tests of the traversal's limits).
+    #[cfg(test)]
+    pub(crate) fn from_parts(
+        nodes: Vec<super::node::WideNode>,
+        order: Vec<u32>,
+        bounds: Aabb,
+    ) -> Bvh {
+        Bvh {
+            nodes: NodeTree::new(nodes),
+            order,
+            bounds,
+        }
     }
 }
 

@@ -1,4 +1,4 @@
-//! The 4-wide BVH node and the per-ray constants of its box test.
+//! The wide BVH node and the per-ray constants of its box test.
 
 use crate::render::geometry::{Aabb, Ray};
 use glam::Vec4;
@@ -37,15 +37,15 @@ pub(crate) const WIDTH: usize = 4 * GROUPS;
 /// Hierarchies", IEEE RT 2008; Wald et al., "Embree", SIGGRAPH 2014, for 8-wide nodes).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub(crate) struct Node4 {
+pub(crate) struct WideNode {
     /// `bounds[axis][0][g]` holds the minima along `axis` of children 4g..4g+3, `[1]` the maxima.
     pub bounds: [[[Vec4; GROUPS]; 2]; 3],
     pub child: [u32; WIDTH],
 }
 
-impl Node4 {
-    pub fn empty() -> Node4 {
-        Node4 {
+impl WideNode {
+    pub fn empty() -> WideNode {
+        WideNode {
             bounds: [[[Vec4::INFINITY; GROUPS], [Vec4::NEG_INFINITY; GROUPS]]; 3],
             child: [EMPTY_CHILD; WIDTH],
         }
@@ -97,7 +97,7 @@ impl NodeRay {
     /// Entry distances of the child boxes and the bitmask of those the ray enters
     /// within `[0, t_max]`.
     #[inline(always)]
-    pub fn hit(&self, node: &Node4, t_max: f32) -> (u32, [Vec4; GROUPS]) {
+    pub fn hit(&self, node: &WideNode, t_max: f32) -> (u32, [Vec4; GROUPS]) {
         let mut mask = 0;
         let mut entry = [Vec4::ZERO; GROUPS];
         for g in 0..GROUPS {

@@ -7,7 +7,7 @@
 //! distance so that it is skipped when popped if a closer hit has been found since.
 
 use super::build::MAX_DEPTH;
-use super::node::{LEAF_BIT, Node4, NodeRay, ROBUST_EXIT_SCALE, WIDTH};
+use super::node::{LEAF_BIT, NodeRay, ROBUST_EXIT_SCALE, WIDTH, WideNode};
 
 /// Each level pushes at most `WIDTH − 1` siblings and there are at most `MAX_DEPTH`
 /// levels, so this bounds the stack of any tree.
@@ -20,12 +20,12 @@ const SMALL_STACK_DEPTH: u32 = (SMALL_STACK as u32 - 1) / (WIDTH as u32 - 1);
 /// The flattened wide nodes (node 0 is the root) and whether the small stack suffices.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct NodeTree {
-    nodes: Vec<Node4>,
+    nodes: Vec<WideNode>,
     shallow: bool,
 }
 
 impl NodeTree {
-    pub fn new(nodes: Vec<Node4>) -> NodeTree {
+    pub fn new(nodes: Vec<WideNode>) -> NodeTree {
         // Children always follow their parent in the depth-first array, so one forward
         // pass finds every node's level.
         let mut level = vec![1u32; nodes.len()];
@@ -47,7 +47,7 @@ impl NodeTree {
         self.nodes.len()
     }
 
-    pub fn nodes(&self) -> &[Node4] {
+    pub fn nodes(&self) -> &[WideNode] {
         &self.nodes
     }
 
@@ -71,7 +71,7 @@ pub(crate) trait ClosestLeaf {
 /// Starts loading every entered child's data at once, so that their cache misses overlap
 /// instead of being taken one after another when each is visited.
 #[inline(always)]
-fn touch_children(nodes: &[Node4], node: &Node4, mut mask: u32, touch_leaf: impl Fn(u32)) {
+fn touch_children(nodes: &[WideNode], node: &WideNode, mut mask: u32, touch_leaf: impl Fn(u32)) {
     while mask != 0 {
         let c = node.child[mask.trailing_zeros() as usize % WIDTH];
         mask &= mask - 1;
@@ -107,7 +107,7 @@ struct Entry {
 /// Returns the final `t_max`.
 #[inline(always)]
 pub(crate) fn closest<const STACK_SIZE: usize>(
-    nodes: &[Node4],
+    nodes: &[WideNode],
     ray: &NodeRay,
     mut t_max: f32,
     leaf: &mut impl ClosestLeaf,
@@ -203,7 +203,7 @@ pub(crate) fn closest<const STACK_SIZE: usize>(
 /// Visits leaves until `leaf.visit(reference, t_max)` reports an occluder; returns whether one did.
 #[inline(always)]
 pub(crate) fn any<const STACK_SIZE: usize>(
-    nodes: &[Node4],
+    nodes: &[WideNode],
     ray: &NodeRay,
     t_max: f32,
     leaf: &mut impl AnyLeaf,

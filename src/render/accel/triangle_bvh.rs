@@ -1,4 +1,4 @@
-//! The triangle-only BVH: leaves hold triangles copied in leaf order into 4-wide SIMD
+//! The triangle-only BVH: leaves hold triangles copied in leaf order into 4-lane SIMD
 //! blocks ([`Triangle4`]), intersected inline during traversal with no callback. This is
 //! the hot path of the renderer.
 
@@ -31,7 +31,8 @@ pub struct TriangleBvh {
     bounds: Aabb,
 }
 
-/// SAH in units of one 4-triangle block test; the 4-wide node visit costs about the same.
+/// SAH in units of one 4-triangle block test; one binary node of the build (an eighth of a
+/// wide node visit, roughly) is charged the same.
 /// Up to 8 triangles (two blocks) per leaf.
 const SETTINGS: BuildSettings = BuildSettings {
     leaf_block: 4,
@@ -225,7 +226,7 @@ impl TriangleBvh {
         self.order.len()
     }
 
-    /// (4-wide nodes, 4-triangle blocks), for statistics.
+    /// (wide nodes, 4-triangle blocks), for statistics.
     pub fn size(&self) -> (usize, usize) {
         (self.nodes.len(), self.packets.len())
     }
