@@ -172,11 +172,11 @@ impl Binner {
         let mut bins = Bins::new();
         for r in refs {
             let b = self.bin(r.centroid2());
-            for a in 0..3 {
-                let slot = &mut bins.bounds[a][b[a]];
+            for (a, &bin) in b.iter().enumerate() {
+                let slot = &mut bins.bounds[a][bin];
                 slot.min = slot.min.min(r.min);
                 slot.max = slot.max.max(r.max);
-                bins.counts[a][b[a]] += 1;
+                bins.counts[a][bin] += 1;
             }
         }
         bins
@@ -211,14 +211,14 @@ fn best_split(bins: &Bins, parent_area: f32, settings: &BuildSettings) -> Option
         let mut acc = Aabb::EMPTY;
         let mut count = 0;
         let total: u32 = bins.counts[axis].iter().sum();
-        for i in 1..BINS {
+        for (i, &right) in right_cost.iter().enumerate().skip(1) {
             acc = acc.union(&bins.bounds[axis][i - 1]);
             count += bins.counts[axis][i - 1];
             if count == 0 || count == total {
                 continue;
             }
             let cost = settings.cost_traversal
-                + (acc.surface_area() * blocks(count) + right_cost[i]) / parent_area;
+                + (acc.surface_area() * blocks(count) + right) / parent_area;
             if best.as_ref().is_none_or(|b| cost < b.cost) {
                 best = Some(Split { axis, bin: i, cost });
             }

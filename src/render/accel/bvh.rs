@@ -8,6 +8,41 @@ use super::traverse::{self, AnyLeaf, ClosestLeaf, LARGE_STACK, NodeTree, SMALL_S
 use crate::render::geometry::{Aabb, Ray};
 
 /// An 8-wide BVH over caller-owned primitives given by their bounding boxes.
+///
+/// Two-level instancing: the top level's primitives are instances, and the closure moves
+/// the ray into the instance's space and traverses the shared object-level BVH. An affine
+/// map keeps the ray parameter (the direction is transformed, not renormalised), so
+/// `t_max` passes straight through.
+///
+/// ```
+/// use radiant::math::{Transform, Vec3};
+/// use radiant::render::accel::{Bvh, TriangleBvh};
+/// use radiant::render::geometry::{Aabb, Ray};
+///
+/// let mesh = TriangleBvh::from_soup(&[[Vec3::ZERO, Vec3::X, Vec3::Y]]);
+/// let instances = [
+///     Transform::translate(Vec3::new(0.0, 0.0, 9.0)),
+///     Transform::translate(Vec3::new(0.0, 0.0, 5.0)),
+/// ];
+/// // (Transforming two corners is enough for translations; in general use all eight.)
+/// let bounds: Vec<Aabb> = instances
+///     .iter()
+///     .map(|x| Aabb::new(x.point(mesh.bounds().min), x.point(mesh.bounds().max)))
+///     .collect();
+/// let scene = Bvh::build(&bounds);
+///
+/// let ray = Ray::new(Vec3::new(0.2, 0.2, 0.0), Vec3::Z);
+/// let mut hit = None;
+/// let t = scene.closest_hit(&ray, f32::INFINITY, |i, t_max| {
+///     let to_object = instances[i as usize].inverse();
+///     let local = Ray::new(to_object.point(ray.o), to_object.vector(ray.d));
+///     let h = mesh.intersect(&local, t_max)?;
+///     hit = Some((i, h.prim, h.b));
+///     Some(h.t)
+/// });
+/// assert!((t.unwrap() - 5.0).abs() < 1e-5);
+/// assert_eq!(hit.map(|h| h.0), Some(1));
+/// ```
 #[derive(Clone, Debug, Default)]
 pub struct Bvh {
     nodes: NodeTree,

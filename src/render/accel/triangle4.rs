@@ -25,14 +25,14 @@ impl Triangle4 {
         };
         let mut lanes = [0; 4];
         let last = tris.len() - 1;
-        for lane in 0..4 {
+        for (lane, prim) in lanes.iter_mut().enumerate() {
             let k = lane.min(last);
             for (vertex, p) in tris[k].iter().enumerate() {
                 for axis in 0..3 {
                     t.v[vertex][axis][lane] = p[axis];
                 }
             }
-            lanes[lane] = prims[k];
+            *prim = prims[k];
         }
         (t, lanes)
     }
