@@ -1,6 +1,6 @@
 //! Stack-based traversal of the wide node array, shared by the generic and the
-//! triangle BVH. Leaves are handed to a closure; the closures are monomorphised and
-//! inlined, so the triangle path pays no indirection.
+//! triangle BVH. Leaves are handed to a visitor (a trait implemented per BVH kind, with
+//! `#[inline(always)]`), so the triangle path is monomorphised and pays no indirection.
 //!
 //! Closest-hit traversal is ordered: of the children a ray enters, the nearest (by entry
 //! distance) is visited next and the others are pushed far-to-near, each with its entry
@@ -26,8 +26,8 @@ pub(crate) struct NodeTree {
 
 impl NodeTree {
     pub fn new(nodes: Vec<WideNode>) -> NodeTree {
-        // Children always follow their parent in the depth-first array, so one forward
-        // pass finds every node's level.
+        // Children always follow their parent in the array, so one forward pass finds
+        // every node's level.
         let mut level = vec![1u32; nodes.len()];
         for i in 0..nodes.len() {
             for &c in &nodes[i].child {
