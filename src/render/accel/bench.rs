@@ -37,23 +37,32 @@ impl Default for RayBenchConfig {
     }
 }
 
-/// What [`ray_benchmark`] measured.
+/// What [`ray_benchmark`] measured. Throughputs are rays per second of wall-clock time on
+/// all rayon threads (the headline figure), and rays per CPU-second of tracing (per-core
+/// speed, robust to other processes competing for the cores; `None` off Linux).
 #[derive(Clone, Copy, Debug)]
 pub struct RayBenchFigures {
+    /// Triangles in the scene (sphere and walls).
     pub triangles: usize,
+    /// Rayon threads used.
     pub threads: usize,
+    /// Wall-clock time of `TriangleBvh::build`.
     pub build_seconds: f64,
+    /// Wide nodes in the tree.
     pub nodes: usize,
+    /// 4-triangle SIMD blocks in the leaves.
     pub blocks: usize,
     pub camera_rays: usize,
+    /// Fraction of camera rays that hit anything.
     pub camera_hit_fraction: f64,
     pub camera_mrays_per_s: f64,
-    /// Rays per CPU-second of tracing (per-core speed; `None` where unmeasured).
     pub camera_mrays_per_cpu_s: Option<f64>,
+    /// One cosine-distributed bounce ray per camera hit.
     pub diffuse_rays: usize,
     pub diffuse_hit_fraction: f64,
     pub diffuse_mrays_per_s: f64,
     pub diffuse_mrays_per_cpu_s: Option<f64>,
+    /// One ray per camera hit towards a random point of the ceiling light.
     pub shadow_rays: usize,
     pub shadow_occluded_fraction: f64,
     pub shadow_mrays_per_s: f64,
