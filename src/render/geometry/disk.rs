@@ -31,6 +31,7 @@ pub struct DiskHit {
 }
 
 impl Disk {
+    /// pbrt's `disk`: `height`, `radius`, `innerradius`, `phimax` in degrees.
     pub fn new(
         height: f32,
         radius: f32,
