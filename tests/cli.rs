@@ -34,9 +34,21 @@ fn renders_the_default_scene_to_every_format() {
     for ext in ["exr", "pfm", "png"] {
         let path = dir.join(format!("cb.{ext}"));
         let out = run(radiant()
-            .args(["render", "--spp", "2", "--resolution", "24x16", "--quiet", "-o"])
+            .args([
+                "render",
+                "--spp",
+                "2",
+                "--resolution",
+                "24x16",
+                "--quiet",
+                "-o",
+            ])
             .arg(&path));
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let img = read_image(&path).unwrap();
         assert_eq!((img.width, img.height), (24, 16));
         assert!(img.mean() > 0.0);
@@ -55,13 +67,19 @@ fn malformed_scenes_fail_cleanly_with_a_location() {
             continue;
         }
         n += 1;
-        let out = run(radiant().args(["render", "--quiet", "-o", "/dev/null.exr"]).arg(&path));
+        let out = run(radiant()
+            .args(["render", "--quiet", "-o", "/dev/null.exr"])
+            .arg(&path));
         let stderr = assert_clean_failure(&out, &path.display().to_string());
         let located = stderr.split_whitespace().any(|w| {
             let parts: Vec<&str> = w.trim_end_matches(':').rsplitn(3, ':').collect();
             parts.len() == 3 && parts[0].parse::<u32>().is_ok() && parts[1].parse::<u32>().is_ok()
         });
-        assert!(located, "{}: no file:line:column in {stderr}", path.display());
+        assert!(
+            located,
+            "{}: no file:line:column in {stderr}",
+            path.display()
+        );
     }
     assert!(n >= 10, "corpus has {n} scenes");
 }
@@ -86,7 +104,15 @@ fn exr_is_bit_identical_at_one_and_two_threads() {
     let render = |threads: &str| {
         let path = dir.join(format!("t{threads}.exr"));
         let out = run(radiant()
-            .args(["render", "cornell-caustics", "--spp", "4", "--resolution", "48x48", "--quiet"])
+            .args([
+                "render",
+                "cornell-caustics",
+                "--spp",
+                "4",
+                "--resolution",
+                "48x48",
+                "--quiet",
+            ])
             .args(["--threads", threads, "-o"])
             .arg(&path));
         assert!(out.status.success());
@@ -95,7 +121,10 @@ fn exr_is_bit_identical_at_one_and_two_threads() {
     let (a, b) = (render("1"), render("2"));
     let (ia, ib) = (read_image(&a).unwrap(), read_image(&b).unwrap());
     let bits = |i: &radiant::image::Image| -> Vec<u32> {
-        i.pixels.iter().flat_map(|p| p.to_array().map(f32::to_bits)).collect()
+        i.pixels
+            .iter()
+            .flat_map(|p| p.to_array().map(f32::to_bits))
+            .collect()
     };
     assert_eq!(bits(&ia), bits(&ib));
 }
@@ -107,14 +136,25 @@ fn interrupt_writes_the_partial_image() {
     let dir = temp_dir("interrupt");
     let path = dir.join("partial.exr");
     let _ = std::fs::remove_file(&path);
-    let mut child = radiant()
-        .args(["render", "--spp", "100000", "--resolution", "64x64", "--quiet", "-o"])
+    let child = radiant()
+        .args([
+            "render",
+            "--spp",
+            "100000",
+            "--resolution",
+            "64x64",
+            "--quiet",
+            "-o",
+        ])
         .arg(&path)
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
     std::thread::sleep(std::time::Duration::from_millis(1500));
-    let status = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
     assert!(status.success());
     let out = child.wait_with_output().unwrap();
     let stderr = assert_clean_failure(&out, "interrupted render");

@@ -19,7 +19,8 @@ use radiant::scene::builtin::builtin_scene;
 
 fn check_unbiased(scene: &str, spp: u32) {
     let reference = read_image(common::shared(&format!("refs/{scene}-256-ref.exr"))).unwrap();
-    let ref_relmse = common::noise_figure(&format!("refs/{scene}-256-ref.noise.txt"), "ref_relmse_est");
+    let ref_relmse =
+        common::noise_figure(&format!("refs/{scene}-256-ref.noise.txt"), "ref_relmse_est");
     let desc = builtin_scene(scene).unwrap();
     let run = |seed| {
         common::render(
@@ -39,10 +40,19 @@ fn check_unbiased(scene: &str, spp: u32) {
         "{scene} @ {spp} spp: relMSE vs ref {:.3e}, own noise {own:.3e}, ref noise {ref_relmse:.3e}, limit {limit:.3e}; mean {:.6} vs {:.6}",
         m.relmse, m.mean_test, m.mean_ref
     );
-    assert!(m.relmse <= limit, "{scene}: relMSE {} above {limit}", m.relmse);
+    assert!(
+        m.relmse <= limit,
+        "{scene}: relMSE {} above {limit}",
+        m.relmse
+    );
     let mean_both = (a.mean() + b.mean()) / 2.0;
     let rel = (mean_both - m.mean_ref).abs() / m.mean_ref;
-    assert!(rel < 0.005, "{scene}: mean {mean_both} vs reference {} ({:.3} %)", m.mean_ref, 100.0 * rel);
+    assert!(
+        rel < 0.005,
+        "{scene}: mean {mean_both} vs reference {} ({:.3} %)",
+        m.mean_ref,
+        100.0 * rel
+    );
 }
 
 #[test]
@@ -63,10 +73,14 @@ fn cornell_caustics_matches_the_reference() {
 fn bitterli_cornell_box_mean_matches_tungsten() {
     let path = common::shared("data/scenes/bitterli/cornell-box/scene-v4.pbrt");
     let mut desc = radiant::scene::parse_file(&path).unwrap();
-    let unused: Vec<_> = desc.warnings.iter().filter(|w| w.message.contains("not used")).collect();
+    let unused: Vec<_> = desc
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("not used"))
+        .collect();
     assert!(unused.is_empty(), "unused parameters: {unused:?}");
-    desc.integrator.params = radiant::scene::ParamSet::new()
-        .with("maxdepth", radiant::scene::ParamValue::Int(vec![65]));
+    desc.integrator.params =
+        radiant::scene::ParamSet::new().with("maxdepth", radiant::scene::ParamValue::Int(vec![65]));
     let img = common::render(
         &desc,
         &Overrides {
@@ -75,8 +89,16 @@ fn bitterli_cornell_box_mean_matches_tungsten() {
             ..Default::default()
         },
     );
-    let tungsten = read_image(common::shared("data/scenes/bitterli/cornell-box/TungstenRender.exr")).unwrap();
+    let tungsten = read_image(common::shared(
+        "data/scenes/bitterli/cornell-box/TungstenRender.exr",
+    ))
+    .unwrap();
     let rel = (img.mean() - tungsten.mean()).abs() / tungsten.mean();
-    eprintln!("bitterli mean {:.6} vs Tungsten {:.6} ({:.2} %)", img.mean(), tungsten.mean(), 100.0 * rel);
+    eprintln!(
+        "bitterli mean {:.6} vs Tungsten {:.6} ({:.2} %)",
+        img.mean(),
+        tungsten.mean(),
+        100.0 * rel
+    );
     assert!(rel < 0.02);
 }

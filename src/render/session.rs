@@ -89,7 +89,9 @@ impl Session {
         let filter = match desc.filter.kind {
             crate::scene::FilterKind::Box => Filter::box_filter(desc.filter.radius),
             crate::scene::FilterKind::Triangle => Filter::triangle(desc.filter.radius),
-            crate::scene::FilterKind::Gaussian { sigma } => Filter::gaussian(desc.filter.radius, sigma),
+            crate::scene::FilterKind::Gaussian { sigma } => {
+                Filter::gaussian(desc.filter.radius, sigma)
+            }
         };
         Ok(Session {
             world,
@@ -137,7 +139,13 @@ impl Session {
     }
 
     /// Adds samples `first .. first + count` to every pixel.
-    fn render_pass(&self, film: &mut Film, first: u32, count: u32, progress: &Progress) -> NonFinite {
+    fn render_pass(
+        &self,
+        film: &mut Film,
+        first: u32,
+        count: u32,
+        progress: &Progress,
+    ) -> NonFinite {
         let width = film.width;
         film.pixels
             .par_chunks_mut(width)
@@ -164,7 +172,9 @@ impl Session {
                     }
                 }
                 progress.rays.fetch_add(rays, Ordering::Relaxed);
-                progress.done.fetch_add(row.len() as u64 * count as u64, Ordering::Relaxed);
+                progress
+                    .done
+                    .fetch_add(row.len() as u64 * count as u64, Ordering::Relaxed);
                 nonfinite
             })
             .reduce(NonFinite::default, |mut a, b| {

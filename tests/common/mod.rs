@@ -13,7 +13,11 @@ pub fn shared(rel: &str) -> PathBuf {
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared"));
     let p = base.join(rel);
-    assert!(p.exists(), "missing shared data {} (is ../shared beside the repository?)", p.display());
+    assert!(
+        p.exists(),
+        "missing shared data {} (is ../shared beside the repository?)",
+        p.display()
+    );
     p
 }
 

@@ -1,5 +1,6 @@
 //! The `radiant` command line: a thin layer over the library.
 
+mod bench_cmd;
 mod compare_cmd;
 mod lens_cmd;
 mod render_cmd;
@@ -7,7 +8,11 @@ mod render_cmd;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "radiant", version, about = "A physically based global-illumination renderer")]
+#[command(
+    name = "radiant",
+    version,
+    about = "A physically based global-illumination renderer"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -19,6 +24,8 @@ enum Command {
     Render(render_cmd::RenderArgs),
     /// Error metrics of a render against a reference image (B is the reference).
     Compare(compare_cmd::CompareArgs),
+    /// Throughput figures: Mrays/s on the Cornell box and a 1M-triangle mesh, render time.
+    Bench(bench_cmd::BenchArgs),
     /// Inspect a realistic-camera lens file: paraxial data, focus, field of view, exit pupil.
     Lens(lens_cmd::LensArgs),
 }
@@ -29,6 +36,7 @@ fn main() {
         Command::Render(args) => render_cmd::run(args),
         Command::Compare(args) => compare_cmd::run(args),
         Command::Lens(args) => lens_cmd::run(args),
+        Command::Bench(args) => bench_cmd::run(args),
     };
     if let Err(e) = result {
         eprintln!("radiant: {e:#}");

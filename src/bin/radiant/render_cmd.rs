@@ -10,7 +10,10 @@ use anyhow::{Context, bail};
 use clap::Args;
 use radiant::image::{ImageMeta, write_image};
 use radiant::render::{Overrides, Progress, Session};
-use radiant::scene::{SceneDesc, builtin::{BUILTIN_SCENES, builtin_scene}};
+use radiant::scene::{
+    SceneDesc,
+    builtin::{BUILTIN_SCENES, builtin_scene},
+};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -169,7 +172,8 @@ fn draw_progress(progress: &Progress, done: &std::sync::atomic::AtomicBool) {
         std::thread::sleep(Duration::from_millis(200));
         bar.set_length(progress.total.load(Ordering::Relaxed).max(1));
         bar.set_position(progress.done.load(Ordering::Relaxed));
-        let mrays = progress.rays.load(Ordering::Relaxed) as f64 / start.elapsed().as_secs_f64() / 1e6;
+        let mrays =
+            progress.rays.load(Ordering::Relaxed) as f64 / start.elapsed().as_secs_f64() / 1e6;
         bar.set_message(format!("{mrays:.1} Mrays/s"));
     }
     bar.finish_and_clear();

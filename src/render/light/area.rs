@@ -7,12 +7,12 @@ use glam::{Vec2, Vec3};
 use super::{EmittedRay, LightSample};
 use crate::color::Rgb;
 use crate::math::{Frame, PI, Transform, sampling};
+use crate::render::geometry::Ray;
 use crate::render::geometry::disk::Disk;
 use crate::render::geometry::ray::offset_origin;
 use crate::render::geometry::sample::{AreaSample, area_pdf_to_solid_angle};
 use crate::render::geometry::sphere::Sphere;
 use crate::render::geometry::triangle::sample_triangle;
-use crate::render::geometry::Ray;
 
 #[derive(Clone, Debug)]
 pub enum LightShape {
@@ -72,7 +72,11 @@ impl AreaLight {
         match &self.shape {
             LightShape::Triangle { p, n, area } => {
                 let s = sample_triangle(p[0], p[1], p[2], u)?;
-                Some(AreaSample { p: s.p, n: *n, pdf: 1.0 / area })
+                Some(AreaSample {
+                    p: s.p,
+                    n: *n,
+                    pdf: 1.0 / area,
+                })
             }
             LightShape::Sphere {
                 sphere,
@@ -80,14 +84,24 @@ impl AreaLight {
                 reverse,
             } => {
                 let s = sphere.sample_area(u);
-                Some(to_render(s, render_from_object, *reverse, similarity_scale2(render_from_object)))
+                Some(to_render(
+                    s,
+                    render_from_object,
+                    *reverse,
+                    similarity_scale2(render_from_object),
+                ))
             }
             LightShape::Disk {
                 disk,
                 render_from_object,
                 reverse,
                 scale2,
-            } => Some(to_render(disk.sample_area(u), render_from_object, *reverse, *scale2)),
+            } => Some(to_render(
+                disk.sample_area(u),
+                render_from_object,
+                *reverse,
+                *scale2,
+            )),
         }
     }
 
@@ -174,7 +188,10 @@ impl AreaLight {
 
 /// Area scale factor of a similarity transform: |det|^(2/3).
 fn similarity_scale2(xf: &Transform) -> f32 {
-    glam::Mat3::from_mat4(xf.m).determinant().abs().powf(2.0 / 3.0)
+    glam::Mat3::from_mat4(xf.m)
+        .determinant()
+        .abs()
+        .powf(2.0 / 3.0)
 }
 
 fn to_render(s: AreaSample, xf: &Transform, reverse: bool, scale2: f32) -> AreaSample {

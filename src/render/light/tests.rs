@@ -73,7 +73,11 @@ fn rectangle_light_irradiance_matches_the_corner_form_factor() {
         e += m;
         var += se * se;
     }
-    assert!((e - exact).abs() < 4.0 * var.sqrt() + 1e-6, "{e} vs {exact} (se {})", var.sqrt());
+    assert!(
+        (e - exact).abs() < 4.0 * var.sqrt() + 1e-6,
+        "{e} vs {exact} (se {})",
+        var.sqrt()
+    );
 }
 
 #[test]
@@ -149,6 +153,9 @@ fn emitted_power_equals_light_power() {
         let mean = s / n as f64;
         let se = ((s2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
         let power = light.power(scene()).g as f64;
-        assert!((mean - power).abs() < 4.0 * se + 1e-6 * power, "{light:?}: {mean} vs {power}");
+        assert!(
+            (mean - power).abs() < 4.0 * se + 1e-6 * power,
+            "{light:?}: {mean} vs {power}"
+        );
     }
 }

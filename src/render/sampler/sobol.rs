@@ -136,7 +136,10 @@ mod tests {
         for dim in 0..2 {
             for i in [0u32, 1, 7, 300, 65_537, 0x8000_0001] {
                 for seed in [0u32, 0x1234_5678, u32::MAX] {
-                    assert_eq!(scrambled_sobol(dim, i, seed), owen_scramble(sobol_u32(dim, i), seed));
+                    assert_eq!(
+                        scrambled_sobol(dim, i, seed),
+                        owen_scramble(sobol_u32(dim, i), seed)
+                    );
                 }
             }
         }

@@ -36,7 +36,13 @@ impl World {
 
         let mut top = ShapeSet::default();
         for shape in &desc.shapes {
-            add_shape(&mut top, shape, &materials, Some(&mut lights), &mut warnings)?;
+            add_shape(
+                &mut top,
+                shape,
+                &materials,
+                Some(&mut lights),
+                &mut warnings,
+            )?;
         }
         for inst in &desc.instances {
             if prototypes[inst.object].is_empty() {
@@ -64,7 +70,11 @@ impl World {
         for l in &desc.lights {
             world.lights.push(light_from_desc(l));
         }
-        let powers: Vec<f32> = world.lights.iter().map(|l| l.power(scene).average()).collect();
+        let powers: Vec<f32> = world
+            .lights
+            .iter()
+            .map(|l| l.power(scene).average())
+            .collect();
         world.light_distribution = Distribution1D::new(&powers);
         Ok((world, warnings))
     }
@@ -79,10 +89,13 @@ impl World {
     }
 }
 
-
 fn light_from_desc(l: &LightDesc) -> Light {
     match l {
-        LightDesc::Point { position, intensity, .. } => Light::Point {
+        LightDesc::Point {
+            position,
+            intensity,
+            ..
+        } => Light::Point {
             position: *position,
             intensity: *intensity,
         },
@@ -100,11 +113,17 @@ fn light_from_desc(l: &LightDesc) -> Light {
             cos_falloff_start: *cos_falloff_start,
             cos_total_width: *cos_total_width,
         },
-        LightDesc::Distant { direction, radiance, .. } => Light::Distant {
+        LightDesc::Distant {
+            direction,
+            radiance,
+            ..
+        } => Light::Distant {
             direction: direction.normalize(),
             radiance: *radiance,
         },
-        LightDesc::Infinite { radiance, .. } => Light::Infinite { radiance: *radiance },
+        LightDesc::Infinite { radiance, .. } => Light::Infinite {
+            radiance: *radiance,
+        },
     }
 }
 
@@ -129,7 +148,10 @@ fn add_shape(
 ) -> Result<(), BuildError> {
     let material = shape.material;
     if materials.get(material as usize).is_none() {
-        return Err(SceneError::at(&shape.loc, format!("material index {material} out of range")));
+        return Err(SceneError::at(
+            &shape.loc,
+            format!("material index {material} out of range"),
+        ));
     }
     let emission = match lights {
         Some(lights) => shape.area_light.clone().map(|a| (a, lights)),
@@ -147,7 +169,15 @@ fn add_shape(
             indices,
             normals,
             uvs,
-        } => add_mesh(set, shape, positions, indices.clone(), normals, uvs, emission),
+        } => add_mesh(
+            set,
+            shape,
+            positions,
+            indices.clone(),
+            normals,
+            uvs,
+            emission,
+        ),
         Geometry::BilinearMesh {
             positions,
             indices,
@@ -275,7 +305,11 @@ fn add_mesh(
 ) {
     let xf = shape.render_from_object;
     let ro = shape.reverse_orientation;
-    let orientation = if ro ^ xf.swaps_handedness() { -1.0 } else { 1.0 };
+    let orientation = if ro ^ xf.swaps_handedness() {
+        -1.0
+    } else {
+        1.0
+    };
     let p: Vec<Vec3> = positions.iter().map(|&v| xf.point(v)).collect();
     // pbrt-v4 flips per-vertex normals under ReverseOrientation.
     let n: Option<Vec<Vec3>> = normals.as_ref().map(|ns| {
@@ -299,11 +333,21 @@ fn add_mesh(
                     // With shading normals the front follows them (pbrt-v4), else the winding.
                     let mut front = cross.normalize();
                     match &n {
-                        Some(ns) if (ns[v[0]] + ns[v[1]] + ns[v[2]]).dot(front) < 0.0 => front = -front,
+                        Some(ns) if (ns[v[0]] + ns[v[1]] + ns[v[2]]).dot(front) < 0.0 => {
+                            front = -front
+                        }
                         Some(_) => {}
                         None => front *= orientation,
                     }
-                    push_light(lights, a, LightShape::Triangle { p: pts, n: front, area })
+                    push_light(
+                        lights,
+                        a,
+                        LightShape::Triangle {
+                            p: pts,
+                            n: front,
+                            area,
+                        },
+                    )
                 } else {
                     NO_LIGHT
                 }

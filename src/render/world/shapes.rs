@@ -77,8 +77,16 @@ pub struct ShapeSet {
 /// What the traversal remembers of the closest hit so far.
 #[derive(Clone, Copy, Debug)]
 enum RawHit {
-    Triangle { index: u32, b: [f32; 3] },
-    Quadric { prim: PrimRef, p_obj: Vec3, n_obj: Vec3, uv: Vec2 },
+    Triangle {
+        index: u32,
+        b: [f32; 3],
+    },
+    Quadric {
+        prim: PrimRef,
+        p_obj: Vec3,
+        n_obj: Vec3,
+        uv: Vec2,
+    },
 }
 
 impl ShapeSet {
@@ -111,14 +119,20 @@ impl ShapeSet {
                     let r = s.shape.radius;
                     transformed_box(
                         &s.render_from_object,
-                        Aabb::new(Vec3::new(-r, -r, s.shape.z_min), Vec3::new(r, r, s.shape.z_max)),
+                        Aabb::new(
+                            Vec3::new(-r, -r, s.shape.z_min),
+                            Vec3::new(r, r, s.shape.z_max),
+                        ),
                     )
                 }
                 PrimRef::Disk(i) => {
                     let d = &self.disks[i as usize];
                     let r = d.shape.radius;
                     let h = d.shape.height;
-                    transformed_box(&d.render_from_object, Aabb::new(Vec3::new(-r, -r, h), Vec3::new(r, r, h)))
+                    transformed_box(
+                        &d.render_from_object,
+                        Aabb::new(Vec3::new(-r, -r, h), Vec3::new(r, r, h)),
+                    )
                 }
                 PrimRef::Instance(i) => {
                     let inst = &self.instances[i as usize];
@@ -131,51 +145,85 @@ impl ShapeSet {
             .collect()
     }
 
-    fn intersect_raw(&self, ray: &Ray, t_max: f32, prototypes: &[ShapeSet]) -> Option<(f32, RawHit, Option<u32>)> {
+    fn intersect_raw(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        prototypes: &[ShapeSet],
+    ) -> Option<(f32, RawHit, Option<u32>)> {
         let mut best: Option<(f32, RawHit, Option<u32>)> = None;
         let mut t_max = t_max;
         if let Some(h) = self.triangle_bvh.intersect(ray, t_max) {
             t_max = h.t;
-            best = Some((h.t, RawHit::Triangle { index: h.prim, b: h.b }, None));
+            best = Some((
+                h.t,
+                RawHit::Triangle {
+                    index: h.prim,
+                    b: h.b,
+                },
+                None,
+            ));
         }
         if self.prims.is_empty() {
             return best;
         }
         let mut quadric: Option<(RawHit, Option<u32>)> = None;
-        let t = self.bvh.closest_hit(ray, t_max, |prim, t_max| match self.prims[prim as usize] {
-            PrimRef::Sphere(i) => {
-                let s = &self.spheres[i as usize];
-                let h = s.shape.intersect(&object_ray(&s.render_from_object, ray), t_max)?;
-                quadric = Some((
-                    RawHit::Quadric { prim: PrimRef::Sphere(i), p_obj: h.p, n_obj: h.n, uv: h.uv },
-                    None,
-                ));
-                Some(h.t)
-            }
-            PrimRef::Disk(i) => {
-                let d = &self.disks[i as usize];
-                let h = d.shape.intersect(&object_ray(&d.render_from_object, ray), t_max)?;
-                quadric = Some((
-                    RawHit::Quadric { prim: PrimRef::Disk(i), p_obj: h.p, n_obj: Vec3::Z, uv: h.uv },
-                    None,
-                ));
-                Some(h.t)
-            }
-            PrimRef::Instance(i) => {
-                let inst = &self.instances[i as usize];
-                let local = object_ray(&inst.render_from_instance, ray);
-                let (t, raw, _) = prototypes[inst.prototype as usize].intersect_raw(&local, t_max, &[])?;
-                quadric = Some((raw, Some(i)));
-                Some(t)
-            }
-        });
+        let t = self
+            .bvh
+            .closest_hit(ray, t_max, |prim, t_max| match self.prims[prim as usize] {
+                PrimRef::Sphere(i) => {
+                    let s = &self.spheres[i as usize];
+                    let h = s
+                        .shape
+                        .intersect(&object_ray(&s.render_from_object, ray), t_max)?;
+                    quadric = Some((
+                        RawHit::Quadric {
+                            prim: PrimRef::Sphere(i),
+                            p_obj: h.p,
+                            n_obj: h.n,
+                            uv: h.uv,
+                        },
+                        None,
+                    ));
+                    Some(h.t)
+                }
+                PrimRef::Disk(i) => {
+                    let d = &self.disks[i as usize];
+                    let h = d
+                        .shape
+                        .intersect(&object_ray(&d.render_from_object, ray), t_max)?;
+                    quadric = Some((
+                        RawHit::Quadric {
+                            prim: PrimRef::Disk(i),
+                            p_obj: h.p,
+                            n_obj: Vec3::Z,
+                            uv: h.uv,
+                        },
+                        None,
+                    ));
+                    Some(h.t)
+                }
+                PrimRef::Instance(i) => {
+                    let inst = &self.instances[i as usize];
+                    let local = object_ray(&inst.render_from_instance, ray);
+                    let (t, raw, _) =
+                        prototypes[inst.prototype as usize].intersect_raw(&local, t_max, &[])?;
+                    quadric = Some((raw, Some(i)));
+                    Some(t)
+                }
+            });
         match (t, quadric) {
             (Some(t), Some((raw, inst))) => Some((t, raw, inst)),
             _ => best,
         }
     }
 
-    pub(crate) fn intersect(&self, ray: &Ray, t_max: f32, prototypes: &[ShapeSet]) -> Option<SurfaceHit> {
+    pub(crate) fn intersect(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        prototypes: &[ShapeSet],
+    ) -> Option<SurfaceHit> {
         let (t, raw, instance) = self.intersect_raw(ray, t_max, prototypes)?;
         match instance {
             None => Some(self.surface_hit(t, raw)),
@@ -196,27 +244,38 @@ impl ShapeSet {
             return true;
         }
         !self.prims.is_empty()
-            && self.bvh.any_hit(ray, t_max, |prim, t_max| match self.prims[prim as usize] {
-                PrimRef::Sphere(i) => {
-                    let s = &self.spheres[i as usize];
-                    s.shape.intersect(&object_ray(&s.render_from_object, ray), t_max).is_some()
-                }
-                PrimRef::Disk(i) => {
-                    let d = &self.disks[i as usize];
-                    d.shape.intersect(&object_ray(&d.render_from_object, ray), t_max).is_some()
-                }
-                PrimRef::Instance(i) => {
-                    let inst = &self.instances[i as usize];
-                    let local = object_ray(&inst.render_from_instance, ray);
-                    prototypes[inst.prototype as usize].occluded(&local, t_max, &[])
-                }
-            })
+            && self
+                .bvh
+                .any_hit(ray, t_max, |prim, t_max| match self.prims[prim as usize] {
+                    PrimRef::Sphere(i) => {
+                        let s = &self.spheres[i as usize];
+                        s.shape
+                            .intersect(&object_ray(&s.render_from_object, ray), t_max)
+                            .is_some()
+                    }
+                    PrimRef::Disk(i) => {
+                        let d = &self.disks[i as usize];
+                        d.shape
+                            .intersect(&object_ray(&d.render_from_object, ray), t_max)
+                            .is_some()
+                    }
+                    PrimRef::Instance(i) => {
+                        let inst = &self.instances[i as usize];
+                        let local = object_ray(&inst.render_from_instance, ray);
+                        prototypes[inst.prototype as usize].occluded(&local, t_max, &[])
+                    }
+                })
     }
 
     fn surface_hit(&self, t: f32, raw: RawHit) -> SurfaceHit {
         match raw {
             RawHit::Triangle { index, b } => self.triangle_hit(t, index, b),
-            RawHit::Quadric { prim, p_obj, n_obj, uv } => {
+            RawHit::Quadric {
+                prim,
+                p_obj,
+                n_obj,
+                uv,
+            } => {
                 let (xf, material, light, reverse) = match prim {
                     PrimRef::Sphere(i) => {
                         let s = &self.spheres[i as usize];
@@ -252,10 +311,16 @@ impl ShapeSet {
         let mut ng = (p1 - p0).cross(p2 - p0).normalize_or_zero() * attr.orientation;
         let mesh = &self.meshes[attr.mesh as usize];
         let tri = 3 * attr.index as usize;
-        let vi = [mesh.indices[tri], mesh.indices[tri + 1], mesh.indices[tri + 2]].map(|v| v as usize);
+        let vi = [
+            mesh.indices[tri],
+            mesh.indices[tri + 1],
+            mesh.indices[tri + 2],
+        ]
+        .map(|v| v as usize);
         let mut ns = ng;
         if let Some(normals) = &mesh.normals {
-            let n = (b[0] * normals[vi[0]] + b[1] * normals[vi[1]] + b[2] * normals[vi[2]]).normalize_or_zero();
+            let n = (b[0] * normals[vi[0]] + b[1] * normals[vi[1]] + b[2] * normals[vi[2]])
+                .normalize_or_zero();
             if n != Vec3::ZERO {
                 ns = n;
                 // With shading normals the geometric normal follows them (pbrt-v4).
