@@ -70,7 +70,7 @@ pub fn radiance(
                     1.0
                 } else {
                     let pdf_light = world.light_distribution.pmf(i)
-                        * light.pdf_li(prev_p, Vec3::ZERO, Vec3::ZERO);
+                        * light.pdf_li(prev_p, Vec3::ZERO, Vec3::ZERO, glam::Vec2::ZERO);
                     power_heuristic(prev_pdf, pdf_light)
                 };
                 l += beta * le * w;
@@ -88,7 +88,7 @@ pub fn radiance(
                     1.0
                 } else {
                     let pdf_light = world.light_distribution.pmf(hit.light as usize)
-                        * area.pdf_li(prev_p, hit.p, hit.ng);
+                        * area.pdf_li(prev_p, hit.p, hit.ng, hit.uv);
                     power_heuristic(prev_pdf, pdf_light)
                 };
                 l += beta * le * w;

@@ -8,6 +8,7 @@ use super::{EmittedRay, LightSample};
 use crate::color::Rgb;
 use crate::math::{Frame, PI, Transform, sampling};
 use crate::render::geometry::Ray;
+use crate::render::geometry::bilinear::BilinearPatch;
 use crate::render::geometry::disk::Disk;
 use crate::render::geometry::ray::offset_origin;
 use crate::render::geometry::sample::{AreaSample, area_pdf_to_solid_angle};
@@ -23,6 +24,11 @@ pub enum LightShape {
         sphere: Sphere,
         render_from_object: Transform,
         reverse: bool,
+    },
+    /// A curved bilinear patch in render space; `orientation` −1 flips ∂p/∂u × ∂p/∂v.
+    Bilinear {
+        patch: BilinearPatch,
+        orientation: f32,
     },
     /// A disk placed by a similarity transform; `scale2` is the area scale factor.
     Disk {
@@ -50,6 +56,7 @@ impl AreaLight {
                 ..
             } => sphere.area() * similarity_scale2(render_from_object),
             LightShape::Disk { disk, scale2, .. } => disk.area() * scale2,
+            LightShape::Bilinear { patch, .. } => patch.area(),
         }
     }
 
@@ -102,6 +109,13 @@ impl AreaLight {
                 *reverse,
                 *scale2,
             )),
+            LightShape::Bilinear { patch, orientation } => {
+                let s = patch.sample_area(u)?;
+                Some(AreaSample {
+                    n: s.n * *orientation,
+                    ..s
+                })
+            }
         }
     }
 
@@ -145,8 +159,9 @@ impl AreaLight {
         })
     }
 
-    /// Solid-angle density of `sample_li` from `p` for the light point `q` (normal `n`).
-    pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3) -> f32 {
+    /// Solid-angle density of `sample_li` from `p` for the light point `q` (normal `n`,
+    /// surface parameters `uv`).
+    pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3, uv: Vec2) -> f32 {
         match &self.shape {
             LightShape::Sphere {
                 sphere,
@@ -155,6 +170,9 @@ impl AreaLight {
             } => {
                 let inv = render_from_object.inverse();
                 sphere.pdf_solid_angle(inv.point(p), inv.point(q))
+            }
+            LightShape::Bilinear { patch, .. } => {
+                area_pdf_to_solid_angle(patch.pdf_area(uv), p, q, n)
             }
             _ => area_pdf_to_solid_angle(1.0 / self.area(), p, q, n),
         }

@@ -143,10 +143,11 @@ impl Light {
     }
 
     /// Solid-angle density with which `sample_li` from `p` would have produced the
-    /// direction towards point `q` (normal `n`) on this light. Zero for delta lights.
-    pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3) -> f32 {
+    /// direction towards point `q` (normal `n`, surface parameters `uv`) on this light.
+    /// Zero for delta lights.
+    pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3, uv: Vec2) -> f32 {
         match self {
-            Light::Area(a) => a.pdf_li(p, q, n),
+            Light::Area(a) => a.pdf_li(p, q, n, uv),
             Light::Infinite { .. } => infinite::PDF,
             _ => 0.0,
         }

@@ -98,7 +98,7 @@ fn sphere_light_irradiance_is_pi_l_sin2() {
     let mut rng = Pcg32::new(1, 1);
     for _ in 0..100 {
         let s = light.sample_li(Vec3::ZERO, u2(&mut rng), scene()).unwrap();
-        let pdf = light.pdf_li(Vec3::ZERO, s.p, s.n);
+        let pdf = light.pdf_li(Vec3::ZERO, s.p, s.n, Vec2::ZERO);
         assert!((pdf - s.pdf).abs() < 1e-3 * s.pdf, "{pdf} vs {}", s.pdf);
     }
 }
@@ -110,7 +110,7 @@ fn triangle_light_pdf_li_matches_its_samples() {
     let mut rng = Pcg32::new(2, 2);
     for _ in 0..100 {
         let s = light.sample_li(p, u2(&mut rng), scene()).unwrap();
-        let pdf = light.pdf_li(p, s.p, s.n);
+        let pdf = light.pdf_li(p, s.p, s.n, Vec2::ZERO);
         assert!((pdf - s.pdf).abs() < 1e-3 * s.pdf);
     }
 }

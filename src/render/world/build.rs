@@ -3,9 +3,10 @@
 
 use glam::{Mat3, Vec2, Vec3};
 
-use super::shapes::{Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr};
+use super::shapes::{BilinearPrim, Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr};
 use super::{NO_LIGHT, World};
 use crate::math::{Distribution1D, Transform};
+use crate::render::geometry::bilinear::BilinearPatch;
 use crate::render::geometry::disk::Disk;
 use crate::render::geometry::sphere::Sphere;
 use crate::render::light::{AreaLight, Light, LightShape, SceneSphere};
@@ -184,25 +185,44 @@ fn add_shape(
             normals,
             uvs,
         } => {
-            // Each patch (p00, p10, p01, p11) as two triangles: exact for planar patches.
+            // Planar patches (p00, p10, p01, p11) become the triangles (p00,p10,p11),
+            // (p00,p11,p01) — exactly what the patch intersector does for them — so they
+            // share the triangle BVH; curved ones stay patches (Reshetov 2019).
+            let orientation = if ro ^ xf.swaps_handedness() {
+                -1.0
+            } else {
+                1.0
+            };
             let mut tris = Vec::with_capacity(indices.len() / 4 * 6);
-            let mut curved = 0usize;
+            let mut emission = emission;
             for q in indices.chunks_exact(4) {
                 let [a, b, c, d] = [q[0], q[1], q[2], q[3]];
-                tris.extend_from_slice(&[a, b, d, a, d, c]);
-                let p = [a, b, c, d].map(|i| positions[i as usize]);
-                let n = (p[1] - p[0]).cross(p[2] - p[0]);
-                let off = n.normalize_or_zero().dot(p[3] - p[0]).abs();
-                if off > 1e-4 * (p[3] - p[0]).length().max(1e-20) {
-                    curved += 1;
+                let [p00, p10, p01, p11] = [a, b, c, d].map(|i| xf.point(positions[i as usize]));
+                let patch = BilinearPatch::new(p00, p10, p01, p11);
+                if patch.is_planar() {
+                    tris.extend_from_slice(&[a, b, d, a, d, c]);
+                    continue;
                 }
+                let light = match &mut emission {
+                    Some((desc, lights)) => {
+                        push_light(lights, desc, LightShape::Bilinear { patch, orientation })
+                    }
+                    None => NO_LIGHT,
+                };
+                let i = set.bilinears.len() as u32;
+                set.bilinears.push(BilinearPrim {
+                    patch,
+                    material,
+                    light,
+                    orientation,
+                });
+                set.prims.push(PrimRef::Bilinear(i));
             }
-            if curved > 0 {
+            if normals.is_some() && !set.bilinears.is_empty() {
                 warnings.push(Warning {
                     loc: shape.loc.clone(),
-                    message: format!(
-                        "{curved} non-planar bilinear patch(es) approximated by two triangles each"
-                    ),
+                    message: "shading normals on curved bilinear patches are not interpolated; geometric normals are used"
+                        .into(),
                 });
             }
             add_mesh(set, shape, positions, tris, normals, uvs, emission)

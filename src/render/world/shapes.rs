@@ -5,6 +5,7 @@ use glam::{Vec2, Vec3};
 use super::{NO_LIGHT, SurfaceHit};
 use crate::math::Transform;
 use crate::render::accel::{Bvh, TriangleBvh};
+use crate::render::geometry::bilinear::BilinearPatch;
 use crate::render::geometry::disk::Disk;
 use crate::render::geometry::sphere::Sphere;
 use crate::render::geometry::{Aabb, Ray};
@@ -15,6 +16,8 @@ use crate::render::geometry::{Aabb, Ray};
 pub(crate) enum PrimRef {
     Sphere(u32),
     Disk(u32),
+    /// A curved bilinear patch (planar ones are stored as two triangles).
+    Bilinear(u32),
     Instance(u32),
 }
 
@@ -50,6 +53,16 @@ pub(crate) struct Placed<S> {
     pub reverse: bool,
 }
 
+/// A curved bilinear patch in render space.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BilinearPrim {
+    pub patch: BilinearPatch,
+    pub material: u32,
+    pub light: u32,
+    /// −1 when the front is opposite ∂p/∂u × ∂p/∂v (ReverseOrientation xor a mirror).
+    pub orientation: f32,
+}
+
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Instance {
     pub prototype: u32,
@@ -67,6 +80,7 @@ pub struct ShapeSet {
     pub(crate) meshes: Vec<MeshAttrs>,
     pub(crate) spheres: Vec<Placed<Sphere>>,
     pub(crate) disks: Vec<Placed<Disk>>,
+    pub(crate) bilinears: Vec<BilinearPrim>,
     pub(crate) instances: Vec<Instance>,
     pub(crate) triangle_bvh: TriangleBvh,
     /// Generic BVH primitive index → primitive.
@@ -133,6 +147,10 @@ impl ShapeSet {
                         &d.render_from_object,
                         Aabb::new(Vec3::new(-r, -r, h), Vec3::new(r, r, h)),
                     )
+                }
+                PrimRef::Bilinear(i) => {
+                    let b = &self.bilinears[i as usize].patch;
+                    Aabb::from_points(&[b.p00, b.p10, b.p01, b.p11])
                 }
                 PrimRef::Instance(i) => {
                     let inst = &self.instances[i as usize];
@@ -203,6 +221,19 @@ impl ShapeSet {
                     ));
                     Some(h.t)
                 }
+                PrimRef::Bilinear(i) => {
+                    let h = self.bilinears[i as usize].patch.intersect(ray, t_max)?;
+                    quadric = Some((
+                        RawHit::Quadric {
+                            prim: PrimRef::Bilinear(i),
+                            p_obj: ray.at(h.t),
+                            n_obj: h.n,
+                            uv: h.uv,
+                        },
+                        None,
+                    ));
+                    Some(h.t)
+                }
                 PrimRef::Instance(i) => {
                     let inst = &self.instances[i as usize];
                     let local = object_ray(&inst.render_from_instance, ray);
@@ -259,6 +290,10 @@ impl ShapeSet {
                             .intersect(&object_ray(&d.render_from_object, ray), t_max)
                             .is_some()
                     }
+                    PrimRef::Bilinear(i) => self.bilinears[i as usize]
+                        .patch
+                        .intersect(ray, t_max)
+                        .is_some(),
                     PrimRef::Instance(i) => {
                         let inst = &self.instances[i as usize];
                         let local = object_ray(&inst.render_from_instance, ray);
@@ -270,6 +305,24 @@ impl ShapeSet {
     fn surface_hit(&self, t: f32, raw: RawHit) -> SurfaceHit {
         match raw {
             RawHit::Triangle { index, b } => self.triangle_hit(t, index, b),
+            RawHit::Quadric {
+                prim: PrimRef::Bilinear(i),
+                p_obj,
+                n_obj,
+                uv,
+            } => {
+                let b = &self.bilinears[i as usize];
+                let n = n_obj * b.orientation;
+                SurfaceHit {
+                    t,
+                    p: p_obj,
+                    ng: n,
+                    ns: n,
+                    uv,
+                    material: b.material,
+                    light: b.light,
+                }
+            }
             RawHit::Quadric {
                 prim,
                 p_obj,
@@ -285,7 +338,7 @@ impl ShapeSet {
                         let d = &self.disks[i as usize];
                         (&d.render_from_object, d.material, d.light, d.reverse)
                     }
-                    _ => unreachable!("quadric hits come from spheres and disks"),
+                    _ => unreachable!("bilinear patches are handled above; instances are resolved"),
                 };
                 let mut n = xf.normal(n_obj).normalize();
                 if reverse {
