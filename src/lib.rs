@@ -9,5 +9,6 @@
 pub mod color;
 pub mod image;
 pub mod math;
+pub mod radiosity;
 pub mod render;
 pub mod scene;

@@ -105,7 +105,9 @@ impl Session {
         let filter = match desc.filter.kind {
             crate::scene::FilterKind::Box => Filter::box_filter(desc.filter.radius),
             crate::scene::FilterKind::Triangle => Filter::triangle(desc.filter.radius),
-            crate::scene::FilterKind::Gaussian { sigma } => Filter::gaussian(desc.filter.radius, sigma),
+            crate::scene::FilterKind::Gaussian { sigma } => {
+                Filter::gaussian(desc.filter.radius, sigma)
+            }
         };
         Ok(Session {
             world,
@@ -128,11 +130,16 @@ impl Session {
 
     /// Renders the image, calling `snapshot(n, image)` each time the samples per pixel
     /// completed (SPPM: iterations) reach a power of two n.
-    pub fn render_with_snapshots(&self, progress: &Progress, snapshot: &mut dyn FnMut(u32, &Image)) -> RenderOutput {
+    pub fn render_with_snapshots(
+        &self,
+        progress: &Progress,
+        snapshot: &mut dyn FnMut(u32, &Image),
+    ) -> RenderOutput {
         let start = Instant::now();
         match &self.integrator {
             Integrator::Path(settings) => {
-                let mut out = self.render_passes(&PixelIntegrator::Path(settings), progress, snapshot);
+                let mut out =
+                    self.render_passes(&PixelIntegrator::Path(settings), progress, snapshot);
                 out.seconds = start.elapsed().as_secs_f64();
                 out
             }
@@ -148,7 +155,11 @@ impl Session {
                     scene: self.world.scene_sphere(),
                     pixel_angle,
                 };
-                let mut out = self.render_passes(&PixelIntegrator::PhotonMap { ctx, seed }, progress, snapshot);
+                let mut out = self.render_passes(
+                    &PixelIntegrator::PhotonMap { ctx, seed },
+                    progress,
+                    snapshot,
+                );
                 out.stats = IntegratorStats::PhotonMap(maps.stats);
                 out.seconds = start.elapsed().as_secs_f64();
                 out
@@ -239,7 +250,8 @@ impl Session {
                 };
                 for (x, film_pixel) in row.iter_mut().enumerate() {
                     for index in first..first + count {
-                        let (l, weight, r) = self.sample_pixel(pixel, &mut scratch, x as u32, y as u32, index);
+                        let (l, weight, r) =
+                            self.sample_pixel(pixel, &mut scratch, x as u32, y as u32, index);
                         rays += r as u64;
                         if l.is_finite() && weight.is_finite() {
                             film_pixel.add(l, weight);
@@ -253,7 +265,9 @@ impl Session {
                     }
                 }
                 progress.rays.fetch_add(rays, Ordering::Relaxed);
-                progress.done.fetch_add(row.len() as u64 * count as u64, Ordering::Relaxed);
+                progress
+                    .done
+                    .fetch_add(row.len() as u64 * count as u64, Ordering::Relaxed);
                 nonfinite
             })
             .reduce(NonFinite::default, |mut a, b| {
@@ -288,7 +302,9 @@ impl Session {
                 };
                 eye::radiance(ctx, cr.ray, &mut sampler, gather, scratch)
             }
-            (PixelIntegrator::PhotonMap { .. }, None) => unreachable!("render_pass makes the scratch"),
+            (PixelIntegrator::PhotonMap { .. }, None) => {
+                unreachable!("render_pass makes the scratch")
+            }
         };
         (l * (cr.weight * self.imaging_ratio), fs.weight, rays)
     }

@@ -57,7 +57,9 @@ impl Integrator {
         let integrator = match desc.name.as_str() {
             "path" => Integrator::Path(PathSettings::from_desc(desc)?),
             "photonmap" => Integrator::PhotonMap(PhotonSettings::from_desc(desc, Visualize::None)?),
-            "photonviz" => Integrator::PhotonMap(PhotonSettings::from_desc(desc, Visualize::Density)?),
+            "photonviz" => {
+                Integrator::PhotonMap(PhotonSettings::from_desc(desc, Visualize::Density)?)
+            }
             "sppm" => Integrator::Sppm(SppmSettings::from_desc(desc)?),
             "volpath" => {
                 warnings.push(Warning {

@@ -44,7 +44,12 @@ impl Default for PathSettings {
 }
 
 /// Radiance along a camera ray; also returns the number of rays traced.
-pub fn radiance(world: &World, settings: &PathSettings, mut ray: Ray, sampler: &mut PixelSample) -> (Rgb, u32) {
+pub fn radiance(
+    world: &World,
+    settings: &PathSettings,
+    mut ray: Ray,
+    sampler: &mut PixelSample,
+) -> (Rgb, u32) {
     let scene = world.scene_sphere();
     let mut l = Rgb::BLACK;
     let mut beta = Rgb::WHITE;
@@ -66,7 +71,8 @@ pub fn radiance(world: &World, settings: &PathSettings, mut ray: Ray, sampler: &
                 let w = if specular_bounce {
                     1.0
                 } else {
-                    let pdf_light = world.light_distribution.pmf(i) * light.pdf_li(prev_p, Vec3::ZERO, Vec3::ZERO);
+                    let pdf_light = world.light_distribution.pmf(i)
+                        * light.pdf_li(prev_p, Vec3::ZERO, Vec3::ZERO, glam::Vec2::ZERO);
                     power_heuristic(prev_pdf, pdf_light)
                 };
                 l += beta * le * w;
@@ -83,8 +89,8 @@ pub fn radiance(world: &World, settings: &PathSettings, mut ray: Ray, sampler: &
                 let w = if specular_bounce {
                     1.0
                 } else {
-                    let pdf_light =
-                        world.light_distribution.pmf(hit.light as usize) * area.pdf_li(prev_p, hit.p, hit.ng);
+                    let pdf_light = world.light_distribution.pmf(hit.light as usize)
+                        * area.pdf_li(prev_p, hit.p, hit.ng, hit.uv);
                     power_heuristic(prev_pdf, pdf_light)
                 };
                 l += beta * le * w;
@@ -137,11 +143,15 @@ pub fn radiance(world: &World, settings: &PathSettings, mut ray: Ray, sampler: &
             break;
         }
         beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-        if let Material::Dielectric { eta } = material {
-            if wi.dot(hit.ng) * wo_world.dot(hit.ng) < 0.0 {
-                // Refraction: track eta^2 so roulette sees the unscaled throughput.
-                eta_scale *= if wo_world.dot(hit.ng) > 0.0 { eta * eta } else { 1.0 / (eta * eta) };
-            }
+        if let Material::Dielectric { eta } = material
+            && wi.dot(hit.ng) * wo_world.dot(hit.ng) < 0.0
+        {
+            // Refraction: track eta^2 so roulette sees the unscaled throughput.
+            eta_scale *= if wo_world.dot(hit.ng) > 0.0 {
+                eta * eta
+            } else {
+                1.0 / (eta * eta)
+            };
         }
         specular_bounce = bs.specular;
         prev_pdf = bs.pdf;

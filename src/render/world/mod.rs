@@ -13,7 +13,6 @@ pub use build::BuildError;
 pub use shapes::ShapeSet;
 
 use crate::math::Distribution1D;
-use crate::render::accel::Bvh;
 use crate::render::geometry::ray::offset_origin;
 use crate::render::geometry::{Aabb, Ray};
 use crate::render::light::Light;
@@ -92,11 +91,8 @@ impl World {
             let m = &self.materials[m as usize];
             m.is_specular() && *m != Material::Interface
         };
-        self.geometry.bounding_spheres_where(&self.prototypes, &pick)
-    }
-
-    pub fn accel(&self) -> &Bvh {
-        &self.geometry.bvh
+        self.geometry
+            .bounding_spheres_where(&self.prototypes, &pick)
     }
 
     /// Centre and radius of a sphere enclosing the scene (for distant and infinite lights).

@@ -16,7 +16,7 @@
 //! - area triangles and disks (each emitting triangle is its own light): P × P cells
 //!   of the area parametrisation, each with its own D × D direction cells;
 //! - distant lights: P × P cells of the disk the parallel rays start from, D = 1;
-//! - spherical area lights and the infinite light: no map (f = 1) — the emission
+//! - spherical and curved-patch area lights and the infinite light: no map (f = 1) — the emission
 //!   direction depends on the position, and a marking would cover nearly everything.
 //!
 //! A cell is marked when the bundle of rays from a ball around the cell's positions,
@@ -161,7 +161,7 @@ fn resolution(light: &Light) -> (u32, u32) {
         Light::Point { .. } | Light::Spot { .. } => (1, DIR_RES),
         Light::Area(a) => match a.shape {
             LightShape::Triangle { .. } | LightShape::Disk { .. } => (AREA_POS_RES, DIR_RES),
-            LightShape::Sphere { .. } => (1, 1),
+            LightShape::Sphere { .. } | LightShape::Bilinear { .. } => (1, 1),
         },
         Light::Distant { .. } => (DISTANT_POS_RES, 1),
         Light::Infinite { .. } => (1, 1),

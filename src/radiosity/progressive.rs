@@ -1,0 +1,331 @@
+//! Progressive refinement (Cohen, Chen, Wallace & Greenberg, "A Progressive Refinement
+//! Approach to Fast Radiosity Image Generation", SIGGRAPH 1988).
+//!
+//! Each step shoots the unshot radiosity `dB_i` of the patch with the most unshot power
+//! `A_i dB_i` to every receiver: `dB_j += rho_j dB_i F_ij A_i / A_j = rho_j dB_i F_ji`
+//! (reciprocity). Only the shooter's column of factors is needed, computed on the fly,
+//! so memory is O(N). An ambient term estimates the light not yet shot, for display.
+//!
+//! Energy is booked per shot: the power `A_i dB_i` leaving the shooter is split into
+//! what reaches receivers (`A_j F_ji dB_i`; a fraction `rho_j` of it becomes unshot
+//! radiosity, the rest is absorbed) and what reaches no patch (escaped, through the
+//! openings of an open scene). So `emitted = absorbed + escaped + unshot` holds at every
+//! step, to rounding, whatever the factors.
+
+use rayon::prelude::*;
+use thiserror::Error;
+
+use super::formfactor::RayCaster;
+use super::hemicube::HemiCube;
+use super::matrix::FormFactorMatrix;
+use super::patch::PatchSet;
+use super::visibility::Visibility;
+
+#[derive(Debug, Error, PartialEq)]
+pub enum ProgressiveError {
+    #[error("band {0} does not exist (bands are 0, 1, 2)")]
+    Band(usize),
+    #[error("{patches} patches but a {matrix} x {matrix} form-factor matrix")]
+    MatrixSize { patches: usize, matrix: usize },
+}
+
+/// How the next shooter is chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShooterSelection {
+    /// Largest `A_i sum_bands dB_i` (all bands shot together).
+    TotalPower,
+    /// Largest unshot power in one band (the classic one-band-at-a-time order).
+    Band(usize),
+}
+
+/// Where a shot's factors come from.
+#[derive(Clone, Copy, Debug)]
+pub enum ShootingFactors<'a> {
+    /// `F_ji` by contour integrals at points on each receiver (with shadow rays).
+    RayCast(&'a RayCaster),
+    /// `F_ij` from a hemi-cube at the shooter's centroid (its own depth buffer).
+    HemiCube(&'a HemiCube),
+    /// A stored matrix (for tests and small scenes).
+    Matrix(&'a FormFactorMatrix<f64>),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProgressiveSettings {
+    /// Stop when the unshot power falls to this fraction of the emitted power (summed
+    /// over bands, or in the selected band for [`ShooterSelection::Band`]).
+    pub unshot_tolerance: f64,
+    pub max_shots: usize,
+    pub selection: ShooterSelection,
+    /// Call the progress hook every this many shots (0: never).
+    pub callback_every: usize,
+}
+
+impl Default for ProgressiveSettings {
+    fn default() -> Self {
+        ProgressiveSettings {
+            unshot_tolerance: 0.01,
+            max_shots: usize::MAX,
+            selection: ShooterSelection::TotalPower,
+            callback_every: 0,
+        }
+    }
+}
+
+/// The solution in progress.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProgressiveState {
+    /// Radiosity gathered so far, per patch and band.
+    pub radiosity: Vec<[f64; 3]>,
+    /// Unshot radiosity `dB`, per patch and band.
+    pub unshot: Vec<[f64; 3]>,
+    pub shots: usize,
+    /// Power per band: emitted in total, absorbed by patches so far, escaped so far
+    /// (reached no patch), and still unshot.
+    pub emitted: [f64; 3],
+    pub absorbed: [f64; 3],
+    pub escaped: [f64; 3],
+    pub unshot_power: [f64; 3],
+}
+
+impl ProgressiveState {
+    /// Start: `B = dB = E`.
+    pub fn new(set: &PatchSet) -> ProgressiveState {
+        let emission: Vec<[f64; 3]> = set.patches.iter().map(|p| p.emission).collect();
+        let emitted = set.emitted_power();
+        ProgressiveState {
+            radiosity: emission.clone(),
+            unshot: emission,
+            shots: 0,
+            emitted,
+            absorbed: [0.0; 3],
+            escaped: [0.0; 3],
+            unshot_power: emitted,
+        }
+    }
+
+    /// Unshot power over emitted power, summed over bands (0 for a dark scene).
+    pub fn unshot_fraction(&self) -> f64 {
+        let emitted: f64 = self.emitted.iter().sum();
+        if emitted > 0.0 {
+            self.unshot_power.iter().sum::<f64>() / emitted
+        } else {
+            0.0
+        }
+    }
+
+    /// Unshot over emitted power per band (0 where a band emits nothing).
+    pub fn unshot_fraction_per_band(&self) -> [f64; 3] {
+        std::array::from_fn(|b| {
+            if self.emitted[b] > 0.0 {
+                self.unshot_power[b] / self.emitted[b]
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// The ambient term of Cohen et al. 1988: the unshot radiosity averaged over the
+    /// area, times the overall interreflection factor `1 / (1 - rho_avg)` with
+    /// `rho_avg` the area-weighted mean reflectance.
+    pub fn ambient(&self, set: &PatchSet) -> [f64; 3] {
+        let total_area = set.total_area();
+        std::array::from_fn(|b| {
+            let mean_reflectance = set
+                .patches
+                .iter()
+                .map(|p| p.area * p.reflectance[b])
+                .sum::<f64>()
+                / total_area;
+            let mean_unshot = self.unshot_power[b] / total_area;
+            if mean_reflectance < 1.0 {
+                mean_unshot / (1.0 - mean_reflectance)
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// Radiosity for display: `B_i + rho_i * ambient`.
+    pub fn display_radiosity(&self, set: &PatchSet) -> Vec<[f64; 3]> {
+        let ambient = self.ambient(set);
+        self.radiosity
+            .iter()
+            .zip(&set.patches)
+            .map(|(b, p)| std::array::from_fn(|k| b[k] + p.reflectance[k] * ambient[k]))
+            .collect()
+    }
+}
+
+/// The outcome of a progressive solve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProgressiveReport {
+    pub state: ProgressiveState,
+    /// Unshot fraction after each shot (as [`ProgressiveState::unshot_fraction`]).
+    pub unshot_fraction: Vec<f64>,
+    /// The same per band.
+    pub unshot_fraction_per_band: Vec<[f64; 3]>,
+    pub converged: bool,
+}
+
+/// Receivers per parallel work item. Fixed (not derived from the thread count) so that
+/// the per-chunk partial sums, and thus every result, are the same on any machine.
+const CHUNK: usize = 512;
+
+/// Partial sums of one chunk of receivers in one shot.
+#[derive(Clone, Copy, Default)]
+struct ShotPartial {
+    incident: [f64; 3],
+    absorbed: [f64; 3],
+    unshot_power: [f64; 3],
+    best_score: f64,
+    best: usize,
+}
+
+/// Shoots until the unshot fraction reaches the tolerance. `on_progress` sees the state
+/// every `callback_every` shots (e.g. to write the classic image sequence).
+pub fn solve_progressive<V: Visibility>(
+    set: &PatchSet,
+    factors: ShootingFactors<'_>,
+    vis: &V,
+    settings: ProgressiveSettings,
+    mut on_progress: impl FnMut(&ProgressiveState),
+) -> Result<ProgressiveReport, ProgressiveError> {
+    let n = set.len();
+    if let ShooterSelection::Band(b) = settings.selection
+        && b > 2
+    {
+        return Err(ProgressiveError::Band(b));
+    }
+    if let ShootingFactors::Matrix(m) = factors
+        && m.len() != n
+    {
+        return Err(ProgressiveError::MatrixSize {
+            patches: n,
+            matrix: m.len(),
+        });
+    }
+    let mut state = ProgressiveState::new(set);
+    let mut fractions = Vec::new();
+    let mut fractions_per_band = Vec::new();
+    let mut hemicube_row = match factors {
+        ShootingFactors::HemiCube(_) => vec![0.0; n],
+        _ => Vec::new(),
+    };
+    let mut hemicube_buffers = match factors {
+        ShootingFactors::HemiCube(h) => Some(h.buffers()),
+        _ => None,
+    };
+    let fraction = |state: &ProgressiveState| match settings.selection {
+        ShooterSelection::TotalPower => state.unshot_fraction(),
+        ShooterSelection::Band(b) => state.unshot_fraction_per_band()[b],
+    };
+    let mut shooter = best_shooter(set, &state.unshot, settings.selection);
+    let mut converged = fraction(&state) <= settings.unshot_tolerance;
+    while !converged && state.shots < settings.max_shots {
+        let Some(i) = shooter else { break };
+        let shot = state.unshot[i];
+        state.unshot[i] = [0.0; 3];
+        let area_i = set.patches[i].area;
+        if let (ShootingFactors::HemiCube(h), Some(buffers)) = (factors, hemicube_buffers.as_mut())
+        {
+            h.row(set, i, buffers, &mut hemicube_row);
+        }
+        // Gathering coefficient F_ji of each receiver j for this shooter.
+        let coefficient = |j: usize| -> f64 {
+            match factors {
+                ShootingFactors::RayCast(r) => r.factor(set, j, i, vis),
+                ShootingFactors::HemiCube(_) => hemicube_row[j] * area_i / set.patches[j].area,
+                ShootingFactors::Matrix(m) => m.get(i, j) * area_i / set.patches[j].area,
+            }
+        };
+        let partials: Vec<ShotPartial> = state
+            .radiosity
+            .par_chunks_mut(CHUNK)
+            .zip(state.unshot.par_chunks_mut(CHUNK))
+            .enumerate()
+            .map(|(chunk, (radiosity, unshot))| {
+                let mut partial = ShotPartial::default();
+                let first = chunk * CHUNK;
+                for (k, (b, db)) in radiosity.iter_mut().zip(unshot.iter_mut()).enumerate() {
+                    let j = first + k;
+                    let patch = &set.patches[j];
+                    let c = coefficient(j);
+                    if c != 0.0 {
+                        for band in 0..3 {
+                            let arriving = c * shot[band];
+                            let reflected = patch.reflectance[band] * arriving;
+                            b[band] += reflected;
+                            db[band] += reflected;
+                            partial.incident[band] += patch.area * arriving;
+                            partial.absorbed[band] += patch.area * (arriving - reflected);
+                        }
+                    }
+                    add_scaled(&mut partial.unshot_power, db, patch.area);
+                    let score = selection_score(patch.area, db, settings.selection);
+                    if score > partial.best_score {
+                        partial.best_score = score;
+                        partial.best = j;
+                    }
+                }
+                partial
+            })
+            .collect();
+        let mut best_score = 0.0;
+        shooter = None;
+        let mut unshot_power = [0.0; 3];
+        for p in &partials {
+            add_scaled(&mut state.absorbed, &p.absorbed, 1.0);
+            add_scaled(&mut state.escaped, &p.incident, -1.0);
+            add_scaled(&mut unshot_power, &p.unshot_power, 1.0);
+            if p.best_score > best_score {
+                best_score = p.best_score;
+                shooter = Some(p.best);
+            }
+        }
+        add_scaled(&mut state.escaped, &shot, area_i);
+        state.unshot_power = unshot_power;
+        state.shots += 1;
+        fractions.push(state.unshot_fraction());
+        fractions_per_band.push(state.unshot_fraction_per_band());
+        converged = fraction(&state) <= settings.unshot_tolerance;
+        if settings.callback_every > 0 && state.shots.is_multiple_of(settings.callback_every) {
+            on_progress(&state);
+        }
+    }
+    Ok(ProgressiveReport {
+        state,
+        unshot_fraction: fractions,
+        unshot_fraction_per_band: fractions_per_band,
+        converged,
+    })
+}
+
+/// `sum += scale * value`, per band.
+#[inline]
+fn add_scaled(sum: &mut [f64; 3], value: &[f64; 3], scale: f64) {
+    for (s, v) in sum.iter_mut().zip(value) {
+        *s += scale * v;
+    }
+}
+
+#[inline]
+fn selection_score(area: f64, unshot: &[f64; 3], selection: ShooterSelection) -> f64 {
+    match selection {
+        ShooterSelection::TotalPower => area * (unshot[0] + unshot[1] + unshot[2]),
+        ShooterSelection::Band(b) => area * unshot[b],
+    }
+}
+
+/// The patch with the largest unshot power (lowest index on ties), if any has some.
+fn best_shooter(set: &PatchSet, unshot: &[[f64; 3]], selection: ShooterSelection) -> Option<usize> {
+    let mut best = None;
+    let mut best_score = 0.0;
+    for (j, (patch, db)) in set.patches.iter().zip(unshot).enumerate() {
+        let score = selection_score(patch.area, db, selection);
+        if score > best_score {
+            best_score = score;
+            best = Some(j);
+        }
+    }
+    best
+}
