@@ -39,7 +39,7 @@ pub use estimate::{EstimatePoint, PhotonMap};
 pub use irradiance::IrradianceCache;
 pub use kdtree::{KdPoint, KdTree, Neighbors};
 pub use projection::ProjectionMaps;
-pub use record::{CAUSTIC, FIRST_DIFFUSE, Photon, RawPhoton};
+pub use record::{CAUSTIC, FIRST_DIFFUSE, FROM_SPECULAR, Photon, RawPhoton};
 pub use settings::{Kernel, PhotonSettings, Visualize};
 
 use crate::render::Progress;
@@ -244,6 +244,9 @@ fn raw_photon(l: &Landing) -> RawPhoton {
         if l.bounces > 0 {
             flags |= CAUSTIC;
         }
+    }
+    if l.first_specular {
+        flags |= FROM_SPECULAR;
     }
     RawPhoton {
         p: l.hit.p,

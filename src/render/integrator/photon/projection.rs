@@ -128,6 +128,18 @@ impl ProjectionMaps {
         self.fractions[light]
     }
 
+    /// True when `(u_pos, u_dir)` lies in a marked cell of `light` (for tests of
+    /// conservativeness: every ray that hits a specular object first must be marked).
+    pub fn contains(&self, light: usize, u_pos: Vec2, u_dir: Vec2) -> bool {
+        let lp = &self.lights[light];
+        let cell = |u: Vec2, res: u32| -> u32 {
+            let c = (u * res as f32).as_uvec2().min(glam::UVec2::splat(res - 1));
+            c.y * res + c.x
+        };
+        let index = cell(u_pos, lp.pos_res) * lp.dir_res * lp.dir_res + cell(u_dir, lp.dir_res);
+        lp.marked.binary_search(&index).is_ok()
+    }
+
     /// Maps uniform numbers into a marked cell of `light`: `u_cell` picks the cell,
     /// `u_pos` and `u_dir` the point within it.
     pub fn remap(

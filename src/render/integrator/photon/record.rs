@@ -20,6 +20,9 @@ use crate::color::Rgb;
 pub const FIRST_DIFFUSE: u8 = 1;
 /// Flag: the path from the light was purely specular before this hit (L S+ D).
 pub const CAUSTIC: u8 = 2;
+/// Flag: the photon's first scattering event was specular (L S …): light that a camera
+/// path can never connect to a point or spot light by next-event estimation.
+pub const FROM_SPECULAR: u8 = 4;
 
 /// A stored photon: where it landed, what it carries, where it came from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -33,7 +36,7 @@ pub struct Photon {
     n: [u16; 2],
     /// Scattering events between the light and this hit (0: direct).
     pub bounces: u8,
-    /// [`FIRST_DIFFUSE`] | [`CAUSTIC`].
+    /// [`FIRST_DIFFUSE`] | [`CAUSTIC`] | [`FROM_SPECULAR`].
     pub flags: u8,
 }
 

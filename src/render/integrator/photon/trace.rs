@@ -65,6 +65,8 @@ pub struct Landing<'a> {
     pub bounces: u32,
     /// Every scattering event so far was specular.
     pub specular_chain: bool,
+    /// The first scattering event (at the first hit) was specular.
+    pub first_specular: bool,
 }
 
 /// Samples a photon: a light by power (or by the projection maps' power aimed at
@@ -114,6 +116,7 @@ pub fn trace_photon(
     mut land: impl FnMut(&Landing) -> bool,
 ) -> u32 {
     let mut specular_chain = true;
+    let mut first_specular = false;
     let mut rays = 0u32;
     for bounces in 0..max_depth {
         rays += 1;
@@ -131,6 +134,7 @@ pub fn trace_photon(
                 power,
                 bounces,
                 specular_chain,
+                first_specular,
             };
             if !land(&landing) {
                 break;
@@ -161,6 +165,9 @@ pub fn trace_photon(
         }
         power *= weight * (1.0 / q);
         specular_chain &= bs.specular;
+        if bounces == 0 {
+            first_specular = bs.specular;
+        }
         ray = hit.spawn_ray(wi_world);
     }
     rays
