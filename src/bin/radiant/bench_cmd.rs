@@ -3,6 +3,7 @@
 use clap::Args;
 use radiant::render::accel::{RayBenchConfig, ray_benchmark};
 use radiant::render::bench::{render_benchmark, world_ray_benchmark};
+use radiant::render::integrator::photon::bench::photon_benchmark;
 use radiant::scene::builtin::cornell_box;
 
 #[derive(Args, Debug)]
@@ -46,6 +47,8 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             "{seconds:.2} s wall on {} threads",
             rayon::current_num_threads()
         );
+        println!("== photon mapping, cornell-caustics");
+        println!("{}", photon_benchmark(args.quick));
     });
     Ok(())
 }

@@ -7,6 +7,9 @@
 //! disjoint, so the build recurses in parallel and gives the same tree at any thread
 //! count (the median selection is deterministic).
 //!
+//! Ranges of at most 8 items are leaves, scanned in order rather than split further
+//! (contiguous, so cheaper than descending to single items).
+//!
 //! Queries: the `k` nearest items within a maximum distance (a bounded max-heap,
 //! Jensen's `locate_photons`), and every item within a fixed radius. Both walk the tree
 //! with an explicit stack, near side first, pruning subtrees whose splitting plane lies
@@ -23,6 +26,10 @@ pub trait KdPoint {
 
 /// Ranges smaller than this are built on the current thread.
 const PARALLEL_BUILD: usize = 16 * 1024;
+
+/// Ranges this small are leaves: scanned in order, not split (contiguous in memory,
+/// cheaper than descending to single items).
+const LEAF: u32 = 8;
 
 /// Deep enough for 2^60 items (each level adds at most one pending entry).
 const STACK: usize = 64;
@@ -87,15 +94,25 @@ impl Neighbors {
 
     /// Squared distance of the farthest item found (0 when none).
     pub fn max_d2(&self) -> f32 {
-        self.heap.first().map_or(0.0, |e| e.0)
+        if self.is_full() {
+            self.heap[0].0
+        } else {
+            self.heap.iter().fold(0.0, |m, e| m.max(e.0))
+        }
     }
 
     /// Index of the farthest item found.
     pub fn farthest(&self) -> Option<u32> {
-        self.heap.first().map(|e| e.1)
+        if self.is_full() {
+            return Some(self.heap[0].1);
+        }
+        self.heap
+            .iter()
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|e| e.1)
     }
 
-    /// (item index, squared distance) of every item found, in heap order.
+    /// (item index, squared distance) of every item found, in no particular order.
     pub fn iter(&self) -> impl Iterator<Item = (u32, f32)> + '_ {
         self.heap.iter().map(|&(d2, i)| (i, d2))
     }
@@ -104,43 +121,47 @@ impl Neighbors {
         self.heap.clear();
     }
 
-    /// Adds a candidate closer than the current bound; returns the new bound
-    /// (the farthest distance once the heap is full, else `bound`).
+    /// Adds a candidate closer than the current bound; returns the new bound (the
+    /// farthest distance once `k` are held, else `bound`). Candidates are collected
+    /// unordered until the buffer is full and only then arranged as a max-heap
+    /// (Jensen 2001, §6.3: heap construction is deferred until needed).
     fn offer(&mut self, d2: f32, index: u32, bound: f32) -> f32 {
+        let k = self.k;
         let h = &mut self.heap;
-        if h.len() < self.k {
+        if h.len() < k {
             h.push((d2, index));
-            let mut i = h.len() - 1;
-            while i > 0 {
-                let parent = (i - 1) / 2;
-                if h[parent].0 >= h[i].0 {
-                    break;
-                }
-                h.swap(parent, i);
-                i = parent;
+            if h.len() < k {
+                return bound;
+            }
+            for i in (0..k / 2).rev() {
+                sift_down(h, i);
             }
         } else {
             h[0] = (d2, index);
-            let n = h.len();
-            let mut i = 0;
-            loop {
-                let l = 2 * i + 1;
-                let r = l + 1;
-                let mut largest = i;
-                if l < n && h[l].0 > h[largest].0 {
-                    largest = l;
-                }
-                if r < n && h[r].0 > h[largest].0 {
-                    largest = r;
-                }
-                if largest == i {
-                    break;
-                }
-                h.swap(i, largest);
-                i = largest;
-            }
+            sift_down(h, 0);
         }
-        if h.len() == self.k { h[0].0 } else { bound }
+        h[0].0
+    }
+}
+
+/// Restores the max-heap property below `i`.
+fn sift_down(h: &mut [(f32, u32)], mut i: usize) {
+    let n = h.len();
+    loop {
+        let l = 2 * i + 1;
+        let r = l + 1;
+        let mut largest = i;
+        if l < n && h[l].0 > h[largest].0 {
+            largest = l;
+        }
+        if r < n && h[r].0 > h[largest].0 {
+            largest = r;
+        }
+        if largest == i {
+            return;
+        }
+        h.swap(i, largest);
+        i = largest;
     }
 }
 
@@ -158,7 +179,7 @@ impl<T: KdPoint + Send> KdTree<T> {
 
 fn build_range<T: KdPoint + Send>(items: &mut [T], axes: &mut [u8], bounds: Aabb) {
     let n = items.len();
-    if n <= 1 {
+    if n <= LEAF as usize {
         return;
     }
     let d = bounds.diagonal();
@@ -240,15 +261,22 @@ impl<T: KdPoint> KdTree<T> {
             if lo >= hi || region_d2 >= bound {
                 continue;
             }
+            if hi - lo <= LEAF {
+                for i in lo..hi {
+                    let item = &self.items[i as usize];
+                    let d2 = (item.position() - p).length_squared();
+                    if d2 < bound && accept(item) {
+                        bound = out.offer(d2, i, bound);
+                    }
+                }
+                continue;
+            }
             let mid = lo + (hi - lo) / 2;
             let item = &self.items[mid as usize];
             let q = item.position();
             let d2 = (q - p).length_squared();
             if d2 < bound && accept(item) {
                 bound = out.offer(d2, mid, bound);
-            }
-            if hi - lo == 1 {
-                continue;
             }
             let axis = self.axes[mid as usize] as usize;
             let delta = p[axis] - q[axis];
@@ -275,15 +303,22 @@ impl<T: KdPoint> KdTree<T> {
             if lo >= hi {
                 continue;
             }
+            if hi - lo <= LEAF {
+                for i in lo..hi {
+                    let item = &self.items[i as usize];
+                    let d2 = (item.position() - p).length_squared();
+                    if d2 < r2 {
+                        visit(i, item, d2);
+                    }
+                }
+                continue;
+            }
             let mid = lo + (hi - lo) / 2;
             let item = &self.items[mid as usize];
             let q = item.position();
             let d2 = (q - p).length_squared();
             if d2 < r2 {
                 visit(mid, item, d2);
-            }
-            if hi - lo == 1 {
-                continue;
             }
             let axis = self.axes[mid as usize] as usize;
             let delta = p[axis] - q[axis];

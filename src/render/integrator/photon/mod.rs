@@ -21,6 +21,7 @@
 //!
 //! `visualize` modes show the maps themselves instead (see [`Visualize`]).
 
+pub mod bench;
 pub mod estimate;
 pub mod eye;
 pub mod irradiance;

@@ -7,10 +7,19 @@
 //! 3 × 3 × 3 cells and a photon looks in one bucket only. Buckets are stored flat (a
 //! prefix-sum table and one entry array), built in point order — deterministic.
 
-use glam::{IVec3, Vec3};
+use glam::{IVec3, Vec3, Vec4};
+use rayon::prelude::*;
 
 use crate::math::hash::mix64;
 use crate::render::geometry::Aabb;
+
+/// An item in a bucket: its sphere (centre, squared radius) and index.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct GridEntry {
+    pub centre: [f32; 3],
+    pub r2: f32,
+    pub index: u32,
+}
 
 /// Visible points by grid cell.
 #[derive(Clone, Debug, Default)]
@@ -19,24 +28,26 @@ pub struct HashGrid {
     inv_cell: f32,
     /// Bucket `b` holds `entries[starts[b] .. starts[b + 1]]`.
     starts: Vec<u32>,
-    entries: Vec<u32>,
+    /// Each entry carries its sphere, so that a lookup reads one bucket sequentially.
+    entries: Vec<GridEntry>,
     mask: u64,
 }
 
 impl HashGrid {
-    /// Builds the grid over `n` items; `item(i)` gives the centre and radius of item `i`
-    /// (None for items without a visible point this iteration).
-    pub fn build(n: usize, item: impl Fn(usize) -> Option<(Vec3, f32)>) -> HashGrid {
-        let mut bounds = Aabb::EMPTY;
-        let mut max_r = 0.0f32;
-        let mut count = 0usize;
-        for i in 0..n {
-            if let Some((p, r)) = item(i) {
-                bounds = bounds.grow(p - Vec3::splat(r)).grow(p + Vec3::splat(r));
-                max_r = max_r.max(r);
-                count += 1;
-            }
-        }
+    /// Builds the grid over spheres given as (centre, squared radius); a negative
+    /// squared radius marks an item without a visible point this iteration.
+    pub fn build(spheres: &[Vec4]) -> HashGrid {
+        let (bounds, max_r, count) = spheres
+            .par_iter()
+            .filter(|s| s.w >= 0.0)
+            .map(|s| {
+                let (p, r) = (s.truncate(), s.w.sqrt());
+                (Aabb::new(p - Vec3::splat(r), p + Vec3::splat(r)), r, 1usize)
+            })
+            .reduce(
+                || (Aabb::EMPTY, 0.0f32, 0usize),
+                |a, b| (a.0.union(&b.0), a.1.max(b.1), a.2 + b.2),
+            );
         if count == 0 || !(max_r > 0.0) {
             return HashGrid::default();
         }
@@ -50,28 +61,39 @@ impl HashGrid {
             entries: Vec::new(),
             mask: table as u64 - 1,
         };
-        let mut buckets = [0u32; 27];
-        for i in 0..n {
-            if let Some((p, r)) = item(i) {
-                for &b in grid.buckets_of(p, r, &mut buckets) {
-                    grid.starts[b as usize + 1] += 1;
-                }
+        // Hashing in parallel; counting and filling in item order (deterministic).
+        let buckets: Vec<([u32; 27], u8)> = spheres
+            .par_iter()
+            .map(|s| {
+                let mut out = [0u32; 27];
+                let k = if s.w >= 0.0 {
+                    grid.buckets_of(s.truncate(), s.w.sqrt(), &mut out).len()
+                } else {
+                    0
+                };
+                (out, k as u8)
+            })
+            .collect();
+        for (list, k) in &buckets {
+            for &b in &list[..*k as usize] {
+                grid.starts[b as usize + 1] += 1;
             }
         }
         for b in 0..table {
             grid.starts[b + 1] += grid.starts[b];
         }
         let mut cursor = grid.starts.clone();
-        grid.entries = vec![0; grid.starts[table] as usize];
-        for i in 0..n {
-            if let Some((p, r)) = item(i) {
-                // Copy out to release the borrow of `grid` before writing entries.
-                let k = grid.buckets_of(p, r, &mut buckets).len();
-                for &b in &buckets[..k] {
-                    let c = &mut cursor[b as usize];
-                    grid.entries[*c as usize] = i as u32;
-                    *c += 1;
-                }
+        grid.entries = vec![GridEntry::default(); grid.starts[table] as usize];
+        for (i, (list, k)) in buckets.iter().enumerate() {
+            let s = spheres[i];
+            for &b in &list[..*k as usize] {
+                let c = &mut cursor[b as usize];
+                grid.entries[*c as usize] = GridEntry {
+                    centre: s.truncate().to_array(),
+                    r2: s.w,
+                    index: i as u32,
+                };
+                *c += 1;
             }
         }
         grid
@@ -113,7 +135,7 @@ impl HashGrid {
     }
 
     /// Items whose sphere may contain `p` (a superset; callers test the distance).
-    pub fn candidates(&self, p: Vec3) -> &[u32] {
+    pub fn candidates(&self, p: Vec3) -> &[GridEntry] {
         if self.entries.is_empty() || !inside(&self.bounds, p) {
             return &[];
         }
@@ -140,13 +162,28 @@ mod tests {
                 (p, 0.05 + rng.uniform() * 0.4)
             })
             .collect();
-        let grid = HashGrid::build(items.len(), |i| (i % 7 != 3).then_some(items[i]));
+        let spheres: Vec<Vec4> = items
+            .iter()
+            .enumerate()
+            .map(|(i, &(p, r))| {
+                if i % 7 != 3 {
+                    p.extend(r * r)
+                } else {
+                    Vec4::new(0.0, 0.0, 0.0, -1.0)
+                }
+            })
+            .collect();
+        let grid = HashGrid::build(&spheres);
         for _ in 0..5000 {
             let q = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 10.0;
             let found = grid.candidates(q);
             let mut seen = std::collections::HashSet::new();
-            for &i in found {
-                assert!(seen.insert(i), "item {i} listed twice");
+            for e in found {
+                assert!(seen.insert(e.index), "item {} listed twice", e.index);
+                assert_eq!(
+                    spheres[e.index as usize],
+                    Vec3::from_array(e.centre).extend(e.r2)
+                );
             }
             for (i, &(p, r)) in items.iter().enumerate() {
                 if i % 7 != 3 && (p - q).length_squared() < r * r {

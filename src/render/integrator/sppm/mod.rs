@@ -23,6 +23,7 @@ use std::fmt;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
+use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
 pub use settings::SppmSettings;
@@ -144,6 +145,7 @@ pub fn render(
         n_pix
     ];
     let mut samples = vec![CameraSample::default(); n_pix];
+    let mut spheres = vec![Vec4::ZERO; n_pix];
     let mut phi = vec![Rgb::BLACK; n_pix];
     let mut count = vec![0u32; n_pix];
     let world = &session.world;
@@ -164,10 +166,19 @@ pub fn render(
             );
         });
         let camera_rays: u64 = samples.par_iter().map(|s| s.rays as u64).sum();
-        let grid = HashGrid::build(n_pix, |i| {
-            let vp = &samples[i].vp;
-            vp.valid.then(|| (vp.p, state[i].r2.sqrt() as f32))
-        });
+        // Positions and squared radii side by side: the photon pass tests many
+        // candidates per hit and reads little else.
+        spheres
+            .par_iter_mut()
+            .zip(samples.par_iter().zip(state.par_iter()))
+            .for_each(|(sp, (s, st))| {
+                *sp = if s.vp.valid {
+                    s.vp.p.extend(st.r2 as f32)
+                } else {
+                    Vec4::new(0.0, 0.0, 0.0, -1.0)
+                };
+            });
+        let grid = HashGrid::build(&spheres);
         stats.camera_seconds += t0.elapsed().as_secs_f64();
 
         let t1 = Instant::now();
@@ -189,11 +200,13 @@ pub fn render(
                         return true;
                     }
                     let p = l.hit.p;
-                    for &j in grid.candidates(p) {
+                    for e in grid.candidates(p) {
+                        if (Vec3::from_array(e.centre) - p).length_squared() >= e.r2 {
+                            continue;
+                        }
+                        let j = e.index;
                         let vp = &samples[j as usize].vp;
-                        if (vp.p - p).length_squared() as f64 >= state[j as usize].r2
-                            || l.wi.dot(vp.n) <= 0.0
-                        {
+                        if l.wi.dot(vp.n) <= 0.0 {
                             continue;
                         }
                         let material = &world.materials[vp.material as usize];
