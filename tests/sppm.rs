@@ -276,19 +276,19 @@ fn cancellation_and_thread_count_keep_the_image_exact() {
     assert_eq!(&out.film.image(), four);
 }
 
-/// The default radius is 3 pixel footprints at the scene centre's distance. For the
+/// The default radius is 2 pixel footprints at the scene centre's distance. For the
 /// pinhole camera of cornell-caustics a pixel at distance t spans t · 2 tan(fov/2) / 256
 /// (to 0.01 % this close to the axis), with t from the camera to the centre of the
 /// scene's bounds.
 #[test]
-fn default_radius_is_three_pixel_footprints() {
+fn default_radius_is_two_pixel_footprints() {
     let desc = with_integrator(cornell_caustics(), "sppm", ParamSet::new(), 256);
     let session = Session::new(&desc, &Overrides::default()).unwrap();
     let r = radiant::render::integrator::sppm::default_radius(&session);
     let centre = session.world.scene_sphere().center;
     let t = (centre - glam::Vec3::new(278.0, 273.0, -800.0)).length();
     let fov = 39.3077f32.to_radians();
-    let expect = 3.0 * t * 2.0 * (fov / 2.0).tan() / 256.0;
+    let expect = 2.0 * t * 2.0 * (fov / 2.0).tan() / 256.0;
     assert!((r / expect - 1.0).abs() < 1e-3, "radius {r} vs {expect}");
 }
 

@@ -116,7 +116,7 @@ pub fn radiance_estimate(
     // radius bounded the region.
     let full = nbrs.is_full() && nbrs.k() > 1;
     let r2 = if full { nbrs.max_d2() } else { max_r2 };
-    if !(r2 > 0.0) {
+    if r2.is_nan() || r2 <= 0.0 {
         return Rgb::BLACK;
     }
     let farthest = nbrs.farthest();

@@ -49,8 +49,8 @@ use crate::scene::SamplerKind;
 use trace::{Landing, PhotonStream, emit, in_chunks, trace_photon};
 
 /// Stream tags of the two photon passes.
-const GLOBAL_PASS: u64 = 0x9106_a1;
-const CAUSTIC_PASS: u64 = 0xca05_71c;
+const GLOBAL_PASS: u64 = 0x0091_06a1;
+const CAUSTIC_PASS: u64 = 0x0ca0_571c;
 
 /// What building the photon maps did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -109,7 +109,7 @@ impl ProjectionMaps {
         let weights: Vec<f32> = powers.iter().zip(&fractions).map(|(p, f)| p * f).collect();
         let total_power: f32 = powers.iter().sum();
         let aimed: f32 = weights.iter().sum();
-        if !(aimed > 0.0) {
+        if aimed.is_nan() || aimed <= 0.0 {
             return None;
         }
         Some(ProjectionMaps {
@@ -277,7 +277,7 @@ fn direction_cone(
         .collect();
     let angle = |a: Vec3, b: Vec3| a.dot(b).clamp(-1.0, 1.0).acos();
     let half = dirs.iter().map(|d| angle(axis, *d)).fold(0.0, f32::max);
-    let gap = max_gap(&dirs, |a, b| angle(a, b));
+    let gap = max_gap(&dirs, angle);
     Some((axis, half + 0.5 * gap + 1e-3))
 }
 

@@ -160,7 +160,7 @@ pub fn trace_photon(
             weight *= (wo.z.abs() * wi_ng.abs()) / denom;
         }
         let q = weight.max_component().min(1.0);
-        if !(q > 0.0) || u_rr >= q {
+        if q.is_nan() || q <= 0.0 || u_rr >= q {
             break;
         }
         power *= weight * (1.0 / q);

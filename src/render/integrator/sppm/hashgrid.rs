@@ -48,7 +48,7 @@ impl HashGrid {
                 || (Aabb::EMPTY, 0.0f32, 0usize),
                 |a, b| (a.0.union(&b.0), a.1.max(b.1), a.2 + b.2),
             );
-        if count == 0 || !(max_r > 0.0) {
+        if count == 0 || max_r.is_nan() || max_r <= 0.0 {
             return HashGrid::default();
         }
         let table = count.next_power_of_two();

@@ -40,7 +40,7 @@ use visible::{CameraSample, camera_sample};
 const SPPM_PASS: u64 = 0x5bb3;
 
 /// Pixel footprints in the default initial radius.
-pub const DEFAULT_RADIUS_PIXELS: f32 = 3.0;
+pub const DEFAULT_RADIUS_PIXELS: f32 = 2.0;
 
 /// What an SPPM render did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

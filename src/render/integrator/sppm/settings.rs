@@ -7,7 +7,7 @@ use crate::scene::{IntegratorDesc, SceneError};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SppmSettings {
     /// `"float radius"` (scene units): the initial gather radius of every pixel.
-    /// Default: three pixel footprints at the distance of the scene's centre (printed
+    /// Default: two pixel footprints at the distance of the scene's centre (printed
     /// and returned in the statistics).
     pub radius: Option<f32>,
     /// `"integer photonsperiteration" [-1]`: photons traced per iteration; -1 (or
