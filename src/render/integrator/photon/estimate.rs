@@ -45,10 +45,12 @@ impl PhotonMap {
         }
     }
 
+    /// Number of stored photons.
     pub fn len(&self) -> usize {
         self.tree.len()
     }
 
+    /// True when no photon was stored.
     pub fn is_empty(&self) -> bool {
         self.tree.is_empty()
     }
@@ -58,6 +60,7 @@ impl PhotonMap {
         self.tree.items()
     }
 
+    /// The kd-tree, for queries.
     pub fn tree(&self) -> &KdTree<Photon> {
         &self.tree
     }

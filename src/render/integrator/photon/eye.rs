@@ -28,6 +28,7 @@ pub struct EyeScratch {
 }
 
 impl EyeScratch {
+    /// Buffers sized for the lookups `maps` makes.
     pub fn new(maps: &PhotonMaps) -> EyeScratch {
         EyeScratch {
             caustic: Neighbors::new(maps.settings.lookup as usize),

@@ -86,10 +86,12 @@ impl IrradianceCache {
         }
     }
 
+    /// Number of precomputed points.
     pub fn len(&self) -> usize {
         self.tree.len()
     }
 
+    /// True when no point was precomputed.
     pub fn is_empty(&self) -> bool {
         self.tree.is_empty()
     }

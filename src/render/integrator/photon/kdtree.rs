@@ -61,6 +61,7 @@ pub struct Neighbors {
 }
 
 impl Neighbors {
+    /// A buffer for the `k` nearest items (at least 1).
     pub fn new(k: usize) -> Neighbors {
         Neighbors {
             k: k.max(1),
@@ -75,14 +76,17 @@ impl Neighbors {
         self.heap.reserve(self.k);
     }
 
+    /// The number of neighbours asked for.
     pub fn k(&self) -> usize {
         self.k
     }
 
+    /// Number of items found.
     pub fn len(&self) -> usize {
         self.heap.len()
     }
 
+    /// True when nothing was found.
     pub fn is_empty(&self) -> bool {
         self.heap.is_empty()
     }
@@ -217,10 +221,12 @@ fn build_range<T: KdPoint + Send>(items: &mut [T], axes: &mut [u8], bounds: Aabb
 }
 
 impl<T: KdPoint> KdTree<T> {
+    /// Number of items in the tree.
     pub fn len(&self) -> usize {
         self.items.len()
     }
 
+    /// True for a tree without items.
     pub fn is_empty(&self) -> bool {
         self.items.is_empty()
     }
@@ -230,6 +236,7 @@ impl<T: KdPoint> KdTree<T> {
         &self.items
     }
 
+    /// The item at a tree index reported by a query.
     pub fn get(&self, index: u32) -> &T {
         &self.items[index as usize]
     }

@@ -120,10 +120,12 @@ impl ProjectionMaps {
         })
     }
 
+    /// Chooses lights in proportion to the power they aim at specular objects.
     pub fn distribution(&self) -> &Distribution1D {
         &self.distribution
     }
 
+    /// Marked fraction of a light's sample space (the weight of its aimed photons).
     pub fn fraction(&self, light: usize) -> f32 {
         self.fractions[light]
     }

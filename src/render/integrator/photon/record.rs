@@ -68,6 +68,7 @@ impl Photon {
         }
     }
 
+    /// Where the photon landed.
     pub fn position(&self) -> Vec3 {
         Vec3::from_array(self.p)
     }

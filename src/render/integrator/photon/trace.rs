@@ -39,6 +39,7 @@ pub struct PhotonStream {
 }
 
 impl PhotonStream {
+    /// The stream of a pass named by the integers `pass`.
     pub fn new(kind: SamplerKind, seed: u64, pass: &[u64]) -> PhotonStream {
         PhotonStream {
             kind,

@@ -1,13 +1,10 @@
-//! Stochastic progressive photon mapping: the furnace, convergence to the
-//! cornell-caustics reference, the spot-lit caustic the path tracer cannot render,
-//! snapshots, cancellation, determinism, the default radius and parameters.
-
-mod common;
+//! Stochastic progressive photon mapping: furnace, convergence to the cornell-caustics
+//! reference, the spot-lit caustic, snapshots, cancellation, determinism, the default
+//! radius and parameters.
 
 use std::sync::atomic::Ordering;
 
-use radiant::color::Rgb;
-use radiant::image::{Crop, Image, compare, read_image};
+use radiant::image::{Image, compare};
 use radiant::render::integrator::photon::{FROM_SPECULAR, PhotonMaps, PhotonSettings, Visualize};
 use radiant::render::integrator::{Integrator, IntegratorStats, SppmStats};
 use radiant::render::{Overrides, Progress, Session};
@@ -15,50 +12,8 @@ use radiant::scene::builtin::{cornell_caustics, furnace};
 use radiant::scene::params::{ParamSet, ParamValue};
 use radiant::scene::{IntegratorDesc, SamplerKind, SceneDesc, parse_file};
 
-/// The glass sphere's caustic in 256 × 256 pixel coordinates (see tests/photon.rs).
-const CAUSTIC_CROP: (usize, usize, usize, usize) = (160, 232, 192, 244);
-/// Floor in the front left of the image, away from the glass's caustic (its pixels see
-/// the floor directly).
-const FLOOR_CROP: (usize, usize, usize, usize) = (32, 232, 128, 252);
-
-fn crop_at(c: (usize, usize, usize, usize), res: usize) -> Crop {
-    let f = 256 / res;
-    Crop {
-        x0: c.0 / f,
-        y0: c.1 / f,
-        x1: c.2 / f,
-        y1: c.3 / f,
-    }
-}
-
-fn reference(res: usize) -> Image {
-    let full = read_image(common::shared("refs/cornell-caustics-256-ref.exr")).expect("reference");
-    let f = full.width / res;
-    let mut out = Image::new(res, res);
-    for y in 0..res {
-        for x in 0..res {
-            let mut s = Rgb::BLACK;
-            for j in 0..f {
-                for i in 0..f {
-                    s += full.get(x * f + i, y * f + j);
-                }
-            }
-            out.set(x, y, s * (1.0 / (f * f) as f32));
-        }
-    }
-    out
-}
-
-fn with_integrator(mut desc: SceneDesc, name: &str, params: ParamSet, res: u32) -> SceneDesc {
-    desc.integrator = IntegratorDesc {
-        name: name.into(),
-        params,
-        loc: desc.integrator.loc.clone(),
-    };
-    desc.film.xresolution = res;
-    desc.film.yresolution = res;
-    desc
-}
+use crate::common;
+use crate::scenes::{CAUSTIC_CROP, FLOOR_CROP, crop_at, reference, with_integrator};
 
 fn sppm_params() -> ParamSet {
     ParamSet::new().with("maxdepth", ParamValue::Int(vec![100]))
@@ -100,7 +55,7 @@ fn render_sppm(
 /// standard errors plus 0.5 % for that correlation.
 #[test]
 fn furnace_converges_to_two() {
-    let desc = with_integrator(furnace(), "sppm", sppm_params(), 64);
+    let desc = with_integrator(furnace(), "sppm", sppm_params(), Some(64));
     let (img, stats, _) = render_sppm(&desc, 32, 2);
     for c in 0..3 {
         let v: Vec<f64> = img.pixels.iter().map(|p| p[c] as f64).collect();
@@ -123,7 +78,7 @@ fn furnace_converges_to_two() {
 /// reference's (the reference's own noise there is ~0.5 %).
 #[test]
 fn cornell_caustics_converges_to_the_reference() {
-    let desc = with_integrator(cornell_caustics(), "sppm", sppm_params(), 64);
+    let desc = with_integrator(cornell_caustics(), "sppm", sppm_params(), Some(64));
     let (img, stats, snaps) = render_sppm(&desc, 256, 2);
     let reference = reference(64);
     let mut last = f64::INFINITY;
@@ -169,9 +124,9 @@ fn spot_lit_caustic_appears_only_with_photons() {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell-caustics-spot.pbrt");
     let desc = parse_file(&path).expect("spot scene");
-    let sppm = with_integrator(desc.clone(), "sppm", sppm_params(), 64);
+    let sppm = with_integrator(desc.clone(), "sppm", sppm_params(), Some(64));
     let (photons, _, _) = render_sppm(&sppm, 64, 2);
-    let path_desc = with_integrator(desc, "path", sppm_params(), 64);
+    let path_desc = with_integrator(desc, "path", sppm_params(), Some(64));
     let traced = common::render(
         &path_desc,
         &Overrides {
@@ -252,7 +207,7 @@ fn spot_lit_caustic_appears_only_with_photons() {
 /// exactly the 4-iteration image; images do not depend on the thread count.
 #[test]
 fn cancellation_and_thread_count_keep_the_image_exact() {
-    let desc = with_integrator(cornell_caustics(), "sppm", sppm_params(), 32);
+    let desc = with_integrator(cornell_caustics(), "sppm", sppm_params(), Some(32));
     let (full, _, snaps) = render_sppm(&desc, 8, 1);
     let (two, _, _) = render_sppm(&desc, 8, 2);
     assert_eq!(full, two);
@@ -282,7 +237,7 @@ fn cancellation_and_thread_count_keep_the_image_exact() {
 /// scene's bounds.
 #[test]
 fn default_radius_is_two_pixel_footprints() {
-    let desc = with_integrator(cornell_caustics(), "sppm", ParamSet::new(), 256);
+    let desc = with_integrator(cornell_caustics(), "sppm", ParamSet::new(), Some(256));
     let session = Session::new(&desc, &Overrides::default()).unwrap();
     let r = radiant::render::integrator::sppm::default_radius(&session);
     let centre = session.world.scene_sphere().center;
