@@ -61,7 +61,7 @@ pub fn camera_sample(
         return out;
     };
     let mut ray = cr.ray;
-    let mut beta = Rgb::splat(cr.weight * fs.weight);
+    let mut beta = Rgb::splat(cr.weight * fs.weight * session.imaging_ratio);
     for depth in 0..=max_depth {
         out.rays += 1;
         let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
