@@ -93,6 +93,9 @@ fn missing_scene_and_bad_arguments_fail_cleanly() {
     assert_clean_failure(&out, "unknown scene name");
     let out = run(radiant().args(["render", "--spp", "2", "--resolution", "8x8", "-o", "x.bmp"]));
     assert_clean_failure(&out, "unknown extension");
+    let out = run(radiant().args(["render", "--integrator", "spmp", "--spp", "1"]));
+    let stderr = assert_clean_failure(&out, "unknown integrator");
+    assert!(stderr.contains("spmp"), "{stderr}");
 }
 
 /// The same scene, seed and spp give the same pixels, bit for bit, at 1 and 2 threads.

@@ -9,6 +9,7 @@ use std::time::Duration;
 use anyhow::{Context, bail};
 use clap::Args;
 use radiant::image::{ImageMeta, write_image};
+use radiant::render::integrator::INTEGRATOR_NAMES;
 use radiant::render::{Overrides, Progress, Session};
 use radiant::scene::{
     SceneDesc,
@@ -79,6 +80,16 @@ pub fn load_scene(scene: Option<&str>) -> anyhow::Result<SceneDesc> {
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    // A scene may name pbrt integrators radiant lacks (a warning, then the path tracer);
+    // a name typed on the command line must be one radiant has.
+    if let Some(name) = &args.integrator
+        && !INTEGRATOR_NAMES.contains(&name.as_str())
+    {
+        bail!(
+            "--integrator {name}: unknown integrator (radiant has: {})",
+            INTEGRATOR_NAMES.join(", ")
+        );
+    }
     let desc = load_scene(args.scene.as_deref())?;
     for w in &desc.warnings {
         eprintln!("{w}");
