@@ -18,8 +18,13 @@ fn render(desc: &SceneDesc, spp: u32, threads: usize) -> Image {
         },
     )
     .expect("scene builds");
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    pool.install(|| session.render(&Progress::default())).film.image()
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| session.render(&Progress::default()))
+        .film
+        .image()
 }
 
 /// Per-pixel statistics of one channel: mean over pixels and the spread between pixels.
@@ -41,9 +46,15 @@ fn white_furnace_is_two_everywhere() {
     for c in 0..3 {
         let (mean, sd) = stats(&img, c);
         let se = sd / (img.pixels.len() as f64).sqrt();
-        assert!((mean - 2.0).abs() < 4.0 * se + 1e-6, "channel {c}: mean {mean}, se {se}");
+        assert!(
+            (mean - 2.0).abs() < 4.0 * se + 1e-6,
+            "channel {c}: mean {mean}, se {se}"
+        );
         for p in &img.pixels {
-            assert!((p[c] as f64 - 2.0).abs() < 5.0 * sd + 1e-6, "pixel {p:?}, sd {sd}");
+            assert!(
+                (p[c] as f64 - 2.0).abs() < 5.0 * sd + 1e-6,
+                "pixel {p:?}, sd {sd}"
+            );
         }
     }
 }
@@ -84,6 +95,11 @@ fn images_are_identical_at_one_and_two_threads() {
     desc.film.yresolution = 48;
     let a = render(&desc, 4, 1);
     let b = render(&desc, 4, 2);
-    assert!(a.pixels.iter().zip(&b.pixels).all(|(p, q)| p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits)));
+    assert!(
+        a.pixels
+            .iter()
+            .zip(&b.pixels)
+            .all(|(p, q)| p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits))
+    );
     assert!(a.mean() > 0.0);
 }

@@ -2,6 +2,7 @@
 //! integrators that turn a scene into film samples.
 
 pub mod accel;
+pub mod bench;
 pub mod camera;
 pub mod geometry;
 pub mod integrator;

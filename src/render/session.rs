@@ -12,12 +12,17 @@ use glam::Vec2;
 use rayon::prelude::*;
 
 use super::camera::Camera;
-use super::integrator::{Integrator, path};
+use super::integrator::footprint::pixel_footprint;
+use super::integrator::photon::PhotonMaps;
+use super::integrator::photon::eye::{self, EyeContext, EyeScratch, GatherStream};
+use super::integrator::{Integrator, IntegratorStats, PathSettings, path, sppm};
 use super::sampler::PixelSample;
 use super::world::World;
 use crate::color::Rgb;
-use crate::image::film::{Film, NonFinite};
+use crate::image::Image;
+use crate::image::film::{Film, FilmPixel, NonFinite};
 use crate::image::filter::Filter;
+use crate::math::hash::hash_u64s;
 use crate::scene::{SamplerKind, SceneDesc, SceneError, Warning};
 
 /// Command-line overrides of the scene's settings.
@@ -66,10 +71,21 @@ pub struct RenderOutput {
     pub film: Film,
     pub seconds: f64,
     pub rays: u64,
-    /// Samples per pixel actually completed in every pixel.
+    /// Samples per pixel (SPPM: iterations) actually completed in every pixel.
     pub spp_done: u32,
     pub interrupted: bool,
+    /// Photon counts, radii and timings of the photon mappers.
+    pub stats: IntegratorStats,
 }
+
+/// The per-pixel integrator of a render, with what it prepared (photon maps).
+enum PixelIntegrator<'a> {
+    Path(&'a PathSettings),
+    PhotonMap { ctx: EyeContext<'a>, seed: u64 },
+}
+
+/// Names the gather-ray streams of the photon mapper.
+const GATHER_TAG: u64 = 0x6a7e;
 
 impl Session {
     pub fn new(desc: &SceneDesc, overrides: &Overrides) -> Result<Session, SceneError> {
@@ -89,7 +105,9 @@ impl Session {
         let filter = match desc.filter.kind {
             crate::scene::FilterKind::Box => Filter::box_filter(desc.filter.radius),
             crate::scene::FilterKind::Triangle => Filter::triangle(desc.filter.radius),
-            crate::scene::FilterKind::Gaussian { sigma } => Filter::gaussian(desc.filter.radius, sigma),
+            crate::scene::FilterKind::Gaussian { sigma } => {
+                Filter::gaussian(desc.filter.radius, sigma)
+            }
         };
         Ok(Session {
             world,
@@ -107,7 +125,74 @@ impl Session {
 
     /// Renders the image. Rayon's current thread pool sets the parallelism.
     pub fn render(&self, progress: &Progress) -> RenderOutput {
+        self.render_with_snapshots(progress, &mut |_, _| {})
+    }
+
+    /// Renders the image, calling `snapshot(n, image)` each time the samples per pixel
+    /// completed (SPPM: iterations) reach a power of two n.
+    pub fn render_with_snapshots(
+        &self,
+        progress: &Progress,
+        snapshot: &mut dyn FnMut(u32, &Image),
+    ) -> RenderOutput {
         let start = Instant::now();
+        match &self.integrator {
+            Integrator::Path(settings) => {
+                let mut out =
+                    self.render_passes(&PixelIntegrator::Path(settings), progress, snapshot);
+                out.seconds = start.elapsed().as_secs_f64();
+                out
+            }
+            Integrator::PhotonMap(settings) => {
+                let seed = settings.seed.unwrap_or(self.seed);
+                let maps = PhotonMaps::build(&self.world, settings, self.sampler, seed, progress);
+                progress.rays.fetch_add(maps.stats.rays, Ordering::Relaxed);
+                let pixel_angle = pixel_footprint(&self.camera, self.resolution, &self.world)
+                    .map_or(1e-3, |(w, t)| w / t);
+                let ctx = EyeContext {
+                    world: &self.world,
+                    maps: &maps,
+                    scene: self.world.scene_sphere(),
+                    pixel_angle,
+                };
+                let mut out = self.render_passes(
+                    &PixelIntegrator::PhotonMap { ctx, seed },
+                    progress,
+                    snapshot,
+                );
+                out.stats = IntegratorStats::PhotonMap(maps.stats);
+                out.seconds = start.elapsed().as_secs_f64();
+                out
+            }
+            Integrator::Sppm(settings) => {
+                let out = sppm::render(self, settings, progress, snapshot);
+                let mut film = Film::new(out.image.width, out.image.height);
+                for (fp, c) in film.pixels.iter_mut().zip(&out.image.pixels) {
+                    *fp = FilmPixel {
+                        sum: [c.r as f64, c.g as f64, c.b as f64],
+                        weight: 1.0,
+                        samples: out.stats.iterations,
+                    };
+                }
+                RenderOutput {
+                    film,
+                    seconds: start.elapsed().as_secs_f64(),
+                    rays: progress.rays.load(Ordering::Relaxed),
+                    spp_done: out.stats.iterations,
+                    interrupted: out.interrupted,
+                    stats: IntegratorStats::Sppm(out.stats),
+                }
+            }
+        }
+    }
+
+    /// The pass loop of the per-pixel integrators.
+    fn render_passes(
+        &self,
+        pixel: &PixelIntegrator,
+        progress: &Progress,
+        snapshot: &mut dyn FnMut(u32, &Image),
+    ) -> RenderOutput {
         let (w, h) = (self.resolution.0 as usize, self.resolution.1 as usize);
         let mut film = Film::new(w, h);
         progress
@@ -117,12 +202,15 @@ impl Session {
         let mut pass = 1u32;
         while spp_done < self.spp && !progress.cancelled() {
             let n = pass.min(self.spp - spp_done);
-            let nonfinite = self.render_pass(&mut film, spp_done, n, progress);
+            let nonfinite = self.render_pass(pixel, &mut film, spp_done, n, progress);
             film.nonfinite.merge(nonfinite);
             if progress.cancelled() {
                 break;
             }
             spp_done += n;
+            if spp_done.is_power_of_two() {
+                snapshot(spp_done, &film.image());
+            }
             if spp_done >= 2 {
                 pass = (pass * 2).min(64);
             }
@@ -130,14 +218,22 @@ impl Session {
         RenderOutput {
             spp_done: film.min_samples(),
             film,
-            seconds: start.elapsed().as_secs_f64(),
+            seconds: 0.0,
             rays: progress.rays.load(Ordering::Relaxed),
             interrupted: progress.cancelled(),
+            stats: IntegratorStats::None,
         }
     }
 
     /// Adds samples `first .. first + count` to every pixel.
-    fn render_pass(&self, film: &mut Film, first: u32, count: u32, progress: &Progress) -> NonFinite {
+    fn render_pass(
+        &self,
+        pixel: &PixelIntegrator,
+        film: &mut Film,
+        first: u32,
+        count: u32,
+        progress: &Progress,
+    ) -> NonFinite {
         let width = film.width;
         film.pixels
             .par_chunks_mut(width)
@@ -148,14 +244,19 @@ impl Session {
                     return nonfinite;
                 }
                 let mut rays = 0u64;
-                for (x, pixel) in row.iter_mut().enumerate() {
+                let mut scratch = match pixel {
+                    PixelIntegrator::PhotonMap { ctx, .. } => Some(EyeScratch::new(ctx.maps)),
+                    PixelIntegrator::Path(_) => None,
+                };
+                for (x, film_pixel) in row.iter_mut().enumerate() {
                     for index in first..first + count {
-                        let (l, weight, r) = self.sample_pixel(x as u32, y as u32, index);
+                        let (l, weight, r) =
+                            self.sample_pixel(pixel, &mut scratch, x as u32, y as u32, index);
                         rays += r as u64;
                         if l.is_finite() && weight.is_finite() {
-                            pixel.add(l, weight);
+                            film_pixel.add(l, weight);
                         } else {
-                            pixel.samples += 1;
+                            film_pixel.samples += 1;
                             nonfinite.merge(NonFinite {
                                 count: 1,
                                 first_pixel: Some((x as u32, y as u32)),
@@ -164,7 +265,9 @@ impl Session {
                     }
                 }
                 progress.rays.fetch_add(rays, Ordering::Relaxed);
-                progress.done.fetch_add(row.len() as u64 * count as u64, Ordering::Relaxed);
+                progress
+                    .done
+                    .fetch_add(row.len() as u64 * count as u64, Ordering::Relaxed);
                 nonfinite
             })
             .reduce(NonFinite::default, |mut a, b| {
@@ -174,7 +277,14 @@ impl Session {
     }
 
     /// One camera sample: radiance, filter weight and rays traced.
-    pub fn sample_pixel(&self, x: u32, y: u32, index: u32) -> (Rgb, f32, u32) {
+    fn sample_pixel(
+        &self,
+        pixel: &PixelIntegrator,
+        scratch: &mut Option<EyeScratch>,
+        x: u32,
+        y: u32,
+        index: u32,
+    ) -> (Rgb, f32, u32) {
         let mut sampler = PixelSample::new(self.sampler, self.seed, x, y, index);
         let fs = self.filter.sample(sampler.get_2d());
         let raster = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + fs.offset;
@@ -182,8 +292,19 @@ impl Session {
         let Some(cr) = self.camera.generate_ray(raster, u_lens) else {
             return (Rgb::BLACK, fs.weight, 0);
         };
-        let (l, rays) = match &self.integrator {
-            Integrator::Path(s) => path::radiance(&self.world, s, cr.ray, &mut sampler),
+        let (l, rays) = match (pixel, scratch) {
+            (PixelIntegrator::Path(s), _) => path::radiance(&self.world, s, cr.ray, &mut sampler),
+            (PixelIntegrator::PhotonMap { ctx, seed }, Some(scratch)) => {
+                let gather = GatherStream {
+                    kind: self.sampler,
+                    seed: *seed,
+                    key: hash_u64s(&[x as u64, y as u64, index as u64, GATHER_TAG]),
+                };
+                eye::radiance(ctx, cr.ray, &mut sampler, gather, scratch)
+            }
+            (PixelIntegrator::PhotonMap { .. }, None) => {
+                unreachable!("render_pass makes the scratch")
+            }
         };
         (l * (cr.weight * self.imaging_ratio), fs.weight, rays)
     }

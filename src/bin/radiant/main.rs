@@ -1,12 +1,18 @@
 //! The `radiant` command line: a thin layer over the library.
 
+mod bench_cmd;
+mod compare_cmd;
 mod lens_cmd;
 mod render_cmd;
 
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "radiant", version, about = "A physically based global-illumination renderer")]
+#[command(
+    name = "radiant",
+    version,
+    about = "A physically based global-illumination renderer"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -16,6 +22,10 @@ struct Cli {
 enum Command {
     /// Render a scene (default: the built-in Cornell box).
     Render(render_cmd::RenderArgs),
+    /// Error metrics of a render against a reference image (B is the reference).
+    Compare(compare_cmd::CompareArgs),
+    /// Throughput figures: Mrays/s on the Cornell box and a 1M-triangle mesh, render time.
+    Bench(bench_cmd::BenchArgs),
     /// Inspect a realistic-camera lens file: paraxial data, focus, field of view, exit pupil.
     Lens(lens_cmd::LensArgs),
 }
@@ -24,7 +34,9 @@ fn main() {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(args),
+        Command::Compare(args) => compare_cmd::run(args),
         Command::Lens(args) => lens_cmd::run(args),
+        Command::Bench(args) => bench_cmd::run(args),
     };
     if let Err(e) = result {
         eprintln!("radiant: {e:#}");

@@ -9,8 +9,12 @@ use std::time::Duration;
 use anyhow::{Context, bail};
 use clap::Args;
 use radiant::image::{ImageMeta, write_image};
+use radiant::render::integrator::INTEGRATOR_NAMES;
 use radiant::render::{Overrides, Progress, Session};
-use radiant::scene::{SceneDesc, builtin::{BUILTIN_SCENES, builtin_scene}};
+use radiant::scene::{
+    SceneDesc,
+    builtin::{BUILTIN_SCENES, builtin_scene},
+};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -28,9 +32,13 @@ pub struct RenderArgs {
     /// Output image; the format follows the extension (.exr, .pfm, .png).
     #[arg(short = 'o', long = "outfile")]
     pub output: Option<PathBuf>,
-    /// Integrator, overriding the scene's (path, sppm, photonmap, radiosity).
+    /// Integrator, overriding the scene's (path, sppm, photonmap, photonviz, radiosity).
     #[arg(long)]
     pub integrator: Option<String>,
+    /// Also write the image whenever the samples per pixel (SPPM: iterations) reach a
+    /// power of two, as NAME-00016.EXT beside the output.
+    #[arg(long)]
+    pub snapshots: bool,
     /// Image size as WIDTHxHEIGHT, overriding the film's.
     #[arg(long, value_parser = parse_resolution)]
     pub resolution: Option<(u32, u32)>,
@@ -72,6 +80,16 @@ pub fn load_scene(scene: Option<&str>) -> anyhow::Result<SceneDesc> {
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    // A scene may name pbrt integrators radiant lacks (a warning, then the path tracer);
+    // a name typed on the command line must be one radiant has.
+    if let Some(name) = &args.integrator
+        && !INTEGRATOR_NAMES.contains(&name.as_str())
+    {
+        bail!(
+            "--integrator {name}: unknown integrator (radiant has: {})",
+            INTEGRATOR_NAMES.join(", ")
+        );
+    }
     let desc = load_scene(args.scene.as_deref())?;
     for w in &desc.warnings {
         eprintln!("{w}");
@@ -114,8 +132,26 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             let bar_done = Arc::clone(&bar_done);
             scope.spawn(move || draw_progress(&progress, &bar_done));
         }
-        let out = pool.install(|| session.render(&progress));
+        let mut snapshot_errors = Vec::new();
+        let mut snapshot = |n: u32, image: &radiant::image::Image| {
+            if !args.snapshots {
+                return;
+            }
+            let path = snapshot_path(&output, n);
+            let meta = ImageMeta {
+                samples_per_pixel: Some(n),
+                render_time_seconds: None,
+                software: format!("radiant {}", env!("CARGO_PKG_VERSION")),
+            };
+            if let Err(e) = write_image(&path, image, &meta, args.exposure) {
+                snapshot_errors.push(format!("writing {}: {e}", path.display()));
+            }
+        };
+        let out = pool.install(|| session.render_with_snapshots(&progress, &mut snapshot));
         bar_done.store(true, Ordering::SeqCst);
+        for e in snapshot_errors {
+            eprintln!("warning: {e}");
+        }
         out
     });
 
@@ -135,6 +171,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         );
     }
     if !args.quiet {
+        let stats = output_data.stats.to_string();
+        for line in stats.lines() {
+            eprintln!("{line}");
+        }
         eprintln!(
             "{}: {}x{}, {} spp, {} integrator, {:.2} s, {:.2} Mrays/s",
             output.display(),
@@ -156,6 +196,18 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `out.exr` → `out-00016.exr`.
+fn snapshot_path(output: &Path, n: u32) -> PathBuf {
+    let stem = output
+        .file_stem()
+        .map_or_else(|| "image".into(), |s| s.to_string_lossy().into_owned());
+    let name = match output.extension() {
+        Some(ext) => format!("{stem}-{n:05}.{}", ext.to_string_lossy()),
+        None => format!("{stem}-{n:05}"),
+    };
+    output.with_file_name(name)
+}
+
 fn draw_progress(progress: &Progress, done: &std::sync::atomic::AtomicBool) {
     let bar = indicatif::ProgressBar::new(progress.total.load(Ordering::Relaxed).max(1));
     bar.set_style(
@@ -169,7 +221,8 @@ fn draw_progress(progress: &Progress, done: &std::sync::atomic::AtomicBool) {
         std::thread::sleep(Duration::from_millis(200));
         bar.set_length(progress.total.load(Ordering::Relaxed).max(1));
         bar.set_position(progress.done.load(Ordering::Relaxed));
-        let mrays = progress.rays.load(Ordering::Relaxed) as f64 / start.elapsed().as_secs_f64() / 1e6;
+        let mrays =
+            progress.rays.load(Ordering::Relaxed) as f64 / start.elapsed().as_secs_f64() / 1e6;
         bar.set_message(format!("{mrays:.1} Mrays/s"));
     }
     bar.finish_and_clear();

@@ -37,23 +37,32 @@ impl Default for RayBenchConfig {
     }
 }
 
-/// What [`ray_benchmark`] measured.
+/// What [`ray_benchmark`] measured. Throughputs are rays per second of wall-clock time on
+/// all rayon threads (the headline figure), and rays per CPU-second of tracing (per-core
+/// speed, robust to other processes competing for the cores; `None` off Linux).
 #[derive(Clone, Copy, Debug)]
 pub struct RayBenchFigures {
+    /// Triangles in the scene (sphere and walls).
     pub triangles: usize,
+    /// Rayon threads used.
     pub threads: usize,
+    /// Wall-clock time of `TriangleBvh::build`.
     pub build_seconds: f64,
+    /// Wide nodes in the tree.
     pub nodes: usize,
+    /// 4-triangle SIMD blocks in the leaves.
     pub blocks: usize,
     pub camera_rays: usize,
+    /// Fraction of camera rays that hit anything.
     pub camera_hit_fraction: f64,
     pub camera_mrays_per_s: f64,
-    /// Rays per CPU-second of tracing (per-core speed; `None` where unmeasured).
     pub camera_mrays_per_cpu_s: Option<f64>,
+    /// One cosine-distributed bounce ray per camera hit.
     pub diffuse_rays: usize,
     pub diffuse_hit_fraction: f64,
     pub diffuse_mrays_per_s: f64,
     pub diffuse_mrays_per_cpu_s: Option<f64>,
+    /// One ray per camera hit towards a random point of the ceiling light.
     pub shadow_rays: usize,
     pub shadow_occluded_fraction: f64,
     pub shadow_mrays_per_s: f64,
@@ -135,11 +144,14 @@ fn uniform2(seed: u64, index: u64, dim: u64) -> Vec2 {
     Vec2::new(u32_to_unit_f32(h as u32), u32_to_unit_f32((h >> 32) as u32))
 }
 
-/// CPU time consumed so far by the calling thread, in seconds (Linux: the first field of
-/// /proc/thread-self/schedstat, in ns). `None` where unavailable.
-fn thread_cpu_seconds() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let ns: u64 = text.split_whitespace().next()?.parse().ok()?;
+/// CPU time consumed so far by all threads of this process, in seconds (Linux: the sum of
+/// the first fields of /proc/self/task/*/schedstat, in ns). `None` where unavailable.
+fn process_cpu_seconds() -> Option<f64> {
+    let mut ns = 0u64;
+    for task in std::fs::read_dir("/proc/self/task").ok()? {
+        let text = std::fs::read_to_string(task.ok()?.path().join("schedstat")).ok()?;
+        ns += text.split_whitespace().next()?.parse::<u64>().ok()?;
+    }
     Some(ns as f64 * 1e-9)
 }
 
@@ -151,8 +163,9 @@ struct Timing {
 }
 
 /// Traces `rays` with `trace` on all threads, `repetitions` times; returns the results of
-/// the last run and the fastest run's timing. CPU time is summed over the worker threads,
-/// so rays per CPU-second measures per-core speed even on a machine shared with others.
+/// the last run and the fastest run's timing. CPU time is summed over the process's
+/// threads, so rays per CPU-second measures per-core speed even when other processes
+/// compete for the cores (wall-clock throughput then drops, CPU-second throughput not).
 fn timed<T: Send + Copy + Default>(
     rays: &[(Ray, f32)],
     repetitions: u32,
@@ -164,28 +177,20 @@ fn timed<T: Send + Copy + Default>(
         cpu: None,
     };
     for _ in 0..repetitions.max(1) {
-        let cpu_ns = std::sync::atomic::AtomicU64::new(0);
-        let cpu_ok = std::sync::atomic::AtomicBool::new(true);
+        let cpu_before = process_cpu_seconds();
         let start = Instant::now();
         out.par_chunks_mut(1024)
             .zip(rays.par_chunks(1024))
             .for_each(|(o, r)| {
-                let before = thread_cpu_seconds();
                 for (slot, (ray, t_max)) in o.iter_mut().zip(r) {
                     *slot = trace(ray, *t_max);
                 }
-                match (before, thread_cpu_seconds()) {
-                    (Some(b), Some(a)) => {
-                        let ns = ((a - b) * 1e9) as u64;
-                        cpu_ns.fetch_add(ns, std::sync::atomic::Ordering::Relaxed);
-                    }
-                    _ => cpu_ok.store(false, std::sync::atomic::Ordering::Relaxed),
-                }
             });
         let wall = start.elapsed().as_secs_f64();
-        let cpu = cpu_ok
-            .into_inner()
-            .then(|| cpu_ns.into_inner() as f64 * 1e-9);
+        let cpu = match (cpu_before, process_cpu_seconds()) {
+            (Some(b), Some(a)) => Some(a - b),
+            _ => None,
+        };
         best.wall = best.wall.min(wall);
         best.cpu = match (best.cpu, cpu) {
             (Some(a), Some(b)) => Some(a.min(b)),

@@ -1,15 +1,15 @@
-//! Binned SAH construction of a binary BVH, then collapse into a 4-wide node array.
+//! Binned SAH construction of a binary BVH, then collapse into a wide (8-child) node array.
 //!
 //! The binary build follows Wald, "On fast Construction of SAH-based Bounding Volume
 //! Hierarchies" (IEEE RT 2007): primitive centroids are binned into a fixed number of
 //! buckets per axis, the surface area heuristic (Goldsmith & Salmon 1987; MacDonald &
 //! Booth 1990) is evaluated at every bucket boundary, and the primitive references are
 //! partitioned in place. Large ranges are binned in parallel and subtrees built with
-//! `rayon::join`. The binary tree is then collapsed into 4-wide nodes by repeatedly
+//! `rayon::join`. The binary tree is then collapsed into wide nodes by repeatedly
 //! opening the child with the largest surface area (as in Wald et al., "Getting Rid of
 //! Packets", IEEE RT 2008, and Embree's BVH4), and flattened depth-first.
 
-use super::node::Node4;
+use super::node::{WIDTH, WideNode};
 use crate::render::geometry::Aabb;
 use glam::Vec3;
 
@@ -172,11 +172,11 @@ impl Binner {
         let mut bins = Bins::new();
         for r in refs {
             let b = self.bin(r.centroid2());
-            for a in 0..3 {
-                let slot = &mut bins.bounds[a][b[a]];
+            for (a, &bin) in b.iter().enumerate() {
+                let slot = &mut bins.bounds[a][bin];
                 slot.min = slot.min.min(r.min);
                 slot.max = slot.max.max(r.max);
-                bins.counts[a][b[a]] += 1;
+                bins.counts[a][bin] += 1;
             }
         }
         bins
@@ -211,14 +211,14 @@ fn best_split(bins: &Bins, parent_area: f32, settings: &BuildSettings) -> Option
         let mut acc = Aabb::EMPTY;
         let mut count = 0;
         let total: u32 = bins.counts[axis].iter().sum();
-        for i in 1..BINS {
+        for (i, &right) in right_cost.iter().enumerate().skip(1) {
             acc = acc.union(&bins.bounds[axis][i - 1]);
             count += bins.counts[axis][i - 1];
             if count == 0 || count == total {
                 continue;
             }
             let cost = settings.cost_traversal
-                + (acc.surface_area() * blocks(count) + right_cost[i]) / parent_area;
+                + (acc.surface_area() * blocks(count) + right) / parent_area;
             if best.as_ref().is_none_or(|b| cost < b.cost) {
                 best = Some(Split { axis, bin: i, cost });
             }
@@ -306,40 +306,39 @@ fn build_range(refs: &mut [PrimRef], offset: u32, depth: u32, s: &BuildSettings)
     }
 }
 
-/// Collapses the binary tree into 4-wide nodes, flattened depth-first (node 0 is the
-/// root). `leaf_ref` turns a leaf's range of the leaf order into an encoded child
-/// reference (so the triangle BVH can repack leaves into SIMD blocks).
-pub(crate) fn collapse(root: &BuildNode, leaf_ref: &mut impl FnMut(u32, u32) -> u32) -> Vec<Node4> {
-    let mut nodes = Vec::new();
+/// Collapses the binary tree into `WIDTH`-wide nodes (node 0 is the root). `leaf_ref`
+/// turns a leaf's range of the leaf order into an encoded child reference (so the triangle
+/// BVH can repack leaves into SIMD blocks).
+///
+/// Layout: the inner children of a node get consecutive slots, and its leaves' data is
+/// packed together before any deeper level's, so that what one node visit touches lies
+/// close together in memory (as in Ylitie et al., "Efficient Incoherent Ray Traversal on
+/// GPUs Through Compressed Wide BVHs", HPG 2017). Parents precede their children.
+pub(crate) fn collapse(
+    root: &BuildNode,
+    leaf_ref: &mut impl FnMut(u32, u32) -> u32,
+) -> Vec<WideNode> {
+    let mut nodes = vec![WideNode::empty()];
     match root {
         BuildNode::Leaf {
             bounds,
             start,
             count,
-        } => {
-            let mut node = Node4::empty();
-            node.set_child(0, bounds, leaf_ref(*start, *count));
-            nodes.push(node);
-        }
-        BuildNode::Inner { .. } => {
-            emit(root, &mut nodes, leaf_ref);
-        }
+        } => nodes[0].set_child(0, bounds, leaf_ref(*start, *count)),
+        BuildNode::Inner { .. } => fill(root, 0, &mut nodes, leaf_ref),
     }
     nodes
 }
 
-/// Emits the 4-wide node for binary inner node `node` and its subtree; returns its index.
-fn emit(
-    node: &BuildNode,
-    nodes: &mut Vec<Node4>,
-    leaf_ref: &mut impl FnMut(u32, u32) -> u32,
-) -> u32 {
+/// The up-to-`WIDTH` binary-tree nodes that become the children of the wide node for
+/// inner node `node`: its two children, then repeatedly the inner child with the largest
+/// surface area replaced by its own two children.
+fn wide_children(node: &BuildNode) -> Vec<&BuildNode> {
     let BuildNode::Inner { children, .. } = node else {
-        unreachable!("emit is only called on inner nodes");
+        return vec![node];
     };
     let mut slots: Vec<&BuildNode> = children.iter().collect();
-    while slots.len() < 4 {
-        // Open the inner child with the largest surface area.
+    while slots.len() < WIDTH {
         let widest = slots
             .iter()
             .enumerate()
@@ -352,18 +351,35 @@ fn emit(
             .map(|(i, _)| i);
         let Some(i) = widest else { break };
         let BuildNode::Inner { children, .. } = slots.swap_remove(i) else {
-            unreachable!()
+            unreachable!("only inner nodes are opened")
         };
         slots.extend(children.iter());
     }
-    let index = nodes.len();
-    nodes.push(Node4::empty());
+    slots
+}
+
+/// Fills the already allocated wide node `index` for binary inner node `node`, then its
+/// subtree.
+fn fill(
+    node: &BuildNode,
+    index: usize,
+    nodes: &mut Vec<WideNode>,
+    leaf_ref: &mut impl FnMut(u32, u32) -> u32,
+) {
+    let slots = wide_children(node);
+    let mut inner = Vec::with_capacity(WIDTH);
     for (k, child) in slots.iter().enumerate() {
         let r = match child {
             BuildNode::Leaf { start, count, .. } => leaf_ref(*start, *count),
-            BuildNode::Inner { .. } => emit(child, nodes, leaf_ref),
+            BuildNode::Inner { .. } => {
+                nodes.push(WideNode::empty());
+                inner.push((nodes.len() - 1, *child));
+                (nodes.len() - 1) as u32
+            }
         };
         nodes[index].set_child(k, child.bounds(), r);
     }
-    index as u32
+    for (i, child) in inner {
+        fill(child, i, nodes, leaf_ref);
+    }
 }

@@ -1,9 +1,9 @@
-//! Ray-tracing acceleration: a 4-wide BVH behind one small interface (closest hit and
+//! Ray-tracing acceleration: an 8-wide BVH behind one small interface (closest hit and
 //! any hit), so that another backend (e.g. Embree) could replace it.
 //!
 //! - [`Bvh`]: generic; primitives are intersected by a caller closure, which may itself
 //!   transform the ray and traverse another BVH (two-level instancing).
-//! - [`TriangleBvh`]: triangles stored in leaf order as 4-wide SIMD blocks and intersected
+//! - [`TriangleBvh`]: triangles stored in leaf order as 4-lane SIMD blocks and intersected
 //!   inline with the watertight test — the fast path.
 //! - [`ray_benchmark`]: the Mrays/s benchmark behind `radiant bench` and `benches/rays.rs`.
 

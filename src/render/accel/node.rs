@@ -1,4 +1,4 @@
-//! The 4-wide BVH node and the per-ray constants of its box test.
+//! The wide BVH node and the per-ray constants of its box test.
 
 use crate::render::geometry::{Aabb, Ray};
 use glam::Vec4;
@@ -26,39 +26,45 @@ pub(crate) fn decode_leaf(r: u32) -> (usize, usize) {
     (((r & !LEAF_BIT) >> 3) as usize, ((r & 7) + 1) as usize)
 }
 
-/// Four child boxes in structure-of-arrays layout, so that one SSE operation tests one
-/// slab of all four (Dammertz et al., "Shallow Bounding Volume Hierarchies for Fast SIMD
-/// Ray Tracing of Incoherent Rays", EGSR 2008; Ernst & Greiner, "Multi Bounding Volume
-/// Hierarchies", IEEE RT 2008). 112 bytes, padded to two cache lines.
+/// SIMD groups of four lanes per node; the node is `WIDTH = 4 · GROUPS` wide.
+pub(crate) const GROUPS: usize = 2;
+/// Children per node.
+pub(crate) const WIDTH: usize = 4 * GROUPS;
+
+/// `WIDTH` child boxes in structure-of-arrays layout, so that one SSE operation tests one
+/// slab of four children (Dammertz et al., "Shallow Bounding Volume Hierarchies for Fast
+/// SIMD Ray Tracing of Incoherent Rays", EGSR 2008; Ernst & Greiner, "Multi Bounding Volume
+/// Hierarchies", IEEE RT 2008; Wald et al., "Embree", SIGGRAPH 2014, for 8-wide nodes).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub(crate) struct Node4 {
-    /// `bounds[axis][0]` holds the four children's minima along `axis`, `[1]` the maxima.
-    pub bounds: [[Vec4; 2]; 3],
-    pub child: [u32; 4],
+pub(crate) struct WideNode {
+    /// `bounds[axis][0][g]` holds the minima along `axis` of children 4g..4g+3, `[1]` the maxima.
+    pub bounds: [[[Vec4; GROUPS]; 2]; 3],
+    pub child: [u32; WIDTH],
 }
 
-impl Node4 {
-    pub fn empty() -> Node4 {
-        Node4 {
-            bounds: [[Vec4::INFINITY, Vec4::NEG_INFINITY]; 3],
-            child: [EMPTY_CHILD; 4],
+impl WideNode {
+    pub fn empty() -> WideNode {
+        WideNode {
+            bounds: [[[Vec4::INFINITY; GROUPS], [Vec4::NEG_INFINITY; GROUPS]]; 3],
+            child: [EMPTY_CHILD; WIDTH],
         }
     }
 
     pub fn set_child(&mut self, k: usize, b: &Aabb, child: u32) {
         for axis in 0..3 {
-            self.bounds[axis][0][k] = b.min[axis];
-            self.bounds[axis][1][k] = b.max[axis];
+            self.bounds[axis][0][k / 4][k % 4] = b.min[axis];
+            self.bounds[axis][1][k / 4][k % 4] = b.max[axis];
         }
         self.child[k] = child;
     }
 }
 
-/// 1 + 2γ(3) with γ(n) = nε / (1 − nε), ε = 2⁻²⁴: scaling the exit distance by it makes the
-/// slab test conservative under f32 round-off (Ize, "Robust BVH Ray Traversal", JCGT 2013),
-/// so the box test never culls a hit the watertight triangle test would report.
-const ROBUST_EXIT_SCALE: f32 = 1.000_000_4;
+/// 1 + 2γ(3) with γ(n) = nε / (1 − nε), ε = 2⁻²⁴: padding the reciprocal direction used for
+/// the exit planes by it makes the slab test conservative under f32 round-off (Ize, "Robust
+/// BVH Ray Traversal", JCGT 2013), so the box test never culls a hit the watertight triangle
+/// test would report.
+pub(crate) const ROBUST_EXIT_SCALE: f32 = 1.000_000_4;
 
 /// Per-ray constants of the four-box slab test (Kay & Kajiya 1986; Williams et al., "An
 /// Efficient and Robust Ray-Box Intersection Algorithm", JGT 2005): the reciprocal
@@ -67,6 +73,8 @@ const ROBUST_EXIT_SCALE: f32 = 1.000_000_4;
 pub(crate) struct NodeRay {
     o: [Vec4; 3],
     inv: [Vec4; 3],
+    /// `inv` padded by [`ROBUST_EXIT_SCALE`], for the exit planes.
+    inv_exit: [Vec4; 3],
     near: [usize; 3],
 }
 
@@ -81,29 +89,38 @@ impl NodeRay {
                 Vec4::splat(ray.o.z),
             ],
             inv: inv.map(Vec4::splat),
+            inv_exit: inv.map(|v| Vec4::splat(v * ROBUST_EXIT_SCALE)),
             near: inv.map(|v| usize::from(v < 0.0)),
         }
     }
 
-    /// Entry distances of the four child boxes and the bitmask of those the ray enters
+    /// Entry distances of the child boxes and the bitmask of those the ray enters
     /// within `[0, t_max]`.
     #[inline(always)]
-    pub fn hit(&self, node: &Node4, t_max: f32) -> (u32, Vec4) {
-        let mut t_in = Vec4::ZERO;
-        let mut t_out = Vec4::splat(t_max);
-        for axis in 0..3 {
-            let s = self.near[axis] & 1;
-            let planes = &node.bounds[axis];
-            let t0 = (planes[s] - self.o[axis]) * self.inv[axis];
-            let t1 = (planes[s ^ 1] - self.o[axis]) * self.inv[axis];
-            // A zero direction component gives inv = ±∞, and a ray starting exactly on a
-            // slab plane then gives 0 · ∞ = NaN. The operand order makes the NaN drop out
-            // (SSE min/max return the second operand when either is NaN, and f32::min/max
-            // ignore NaN), which treats the ray as inside that slab: correct, as it lies
-            // on the plane.
-            t_in = t0.max(t_in);
-            t_out = (t1 * ROBUST_EXIT_SCALE).min(t_out);
+    pub fn hit(&self, node: &WideNode, t_max: f32) -> (u32, [Vec4; GROUPS]) {
+        let mut mask = 0;
+        let mut entry = [Vec4::ZERO; GROUPS];
+        for g in 0..GROUPS {
+            let mut t_in = Vec4::ZERO;
+            // The computed entry distance may exceed the true one by the same round-off, so
+            // the limit is padded too: a box entered just before t_max is never culled.
+            let mut t_out = Vec4::splat(t_max * ROBUST_EXIT_SCALE);
+            for axis in 0..3 {
+                let s = self.near[axis] & 1;
+                let planes = &node.bounds[axis];
+                let t0 = (planes[s][g] - self.o[axis]) * self.inv[axis];
+                let t1 = (planes[s ^ 1][g] - self.o[axis]) * self.inv_exit[axis];
+                // A zero direction component gives inv = ±∞, and a ray starting exactly on a
+                // slab plane then gives 0 · ∞ = NaN. The operand order makes the NaN drop out
+                // (SSE min/max return the second operand when either is NaN, and f32::min/max
+                // ignore NaN), which treats the ray as inside that slab: correct, as it lies
+                // on the plane.
+                t_in = t0.max(t_in);
+                t_out = t1.min(t_out);
+            }
+            mask |= t_in.cmple(t_out).bitmask() << (4 * g);
+            entry[g] = t_in;
         }
-        (t_in.cmple(t_out).bitmask(), t_in)
+        (mask, entry)
     }
 }

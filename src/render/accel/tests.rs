@@ -276,3 +276,68 @@ fn empty_and_degenerate_inputs() {
     order.sort_unstable();
     assert!(order.iter().enumerate().all(|(k, &p)| k as u32 == p));
 }
+
+#[test]
+fn deep_trees_use_the_large_stack_and_stay_exact() {
+    // A hand-made worst case for the traversal stack: a chain of 30 wide nodes whose boxes
+    // all enclose the whole scene, each with one inner child and WIDTH − 1 leaves, so a ray
+    // pushes WIDTH − 1 entries per level. The small stack would overflow; the tree must be
+    // recognised as deep and still answer exactly.
+    use super::node::{WIDTH, WideNode, encode_leaf};
+    let levels = 30;
+    let per_level = WIDTH - 1;
+    let mut rng = Pcg32::new(77, 1);
+    let spheres: Vec<(Vec3, f32)> = (0..levels * per_level)
+        .map(|_| (rv(&mut rng), 0.02 + 0.05 * rng.uniform()))
+        .collect();
+    let all = Aabb::new(Vec3::splat(-1.0), Vec3::splat(2.0));
+    let nodes: Vec<WideNode> = (0..levels)
+        .map(|level| {
+            let mut node = WideNode::empty();
+            for k in 0..per_level {
+                node.set_child(k, &all, encode_leaf((level * per_level + k) as u32, 1));
+            }
+            if level + 1 < levels {
+                node.set_child(per_level, &all, level as u32 + 1);
+            }
+            node
+        })
+        .collect();
+    let order: Vec<u32> = (0..spheres.len() as u32).collect();
+    let bvh = Bvh::from_parts(nodes, order, all);
+    assert!(!bvh.nodes_are_shallow());
+    let hit = |i: u32, ray: &Ray, t_max: f32| {
+        let (c, r) = spheres[i as usize];
+        Sphere::full(r)
+            .unwrap()
+            .intersect(&Ray::new(ray.o - c, ray.d), t_max)
+            .map(|h| h.t)
+    };
+    let mut hits = 0;
+    for _ in 0..500 {
+        let o = Vec3::new(-0.5, rng.uniform(), rng.uniform());
+        let ray = Ray::new(o, rv(&mut rng) - o);
+        let brute = (0..spheres.len() as u32)
+            .filter_map(|i| hit(i, &ray, f32::INFINITY))
+            .min_by(f32::total_cmp);
+        assert_eq!(
+            bvh.closest_hit(&ray, f32::INFINITY, |i, t| hit(i, &ray, t)),
+            brute
+        );
+        let mut visited = 0;
+        let any = bvh.any_hit(&ray, f32::INFINITY, |i, t| {
+            visited += 1;
+            hit(i, &ray, t).is_some()
+        });
+        assert_eq!(any, brute.is_some());
+        if !any {
+            assert_eq!(
+                visited,
+                spheres.len(),
+                "a miss must test every primitive here"
+            );
+        }
+        hits += usize::from(brute.is_some());
+    }
+    assert!(hits > 100, "{hits}");
+}

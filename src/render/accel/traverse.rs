@@ -1,17 +1,100 @@
-//! Stack-based traversal of the 4-wide node array, shared by the generic and the
-//! triangle BVH. Leaves are handed to a closure; the closures are monomorphised and
-//! inlined, so the triangle path pays no indirection.
+//! Stack-based traversal of the wide node array, shared by the generic and the
+//! triangle BVH. Leaves are handed to a visitor (a trait implemented per BVH kind, with
+//! `#[inline(always)]`), so the triangle path is monomorphised and pays no indirection.
 //!
 //! Closest-hit traversal is ordered: of the children a ray enters, the nearest (by entry
 //! distance) is visited next and the others are pushed far-to-near, each with its entry
 //! distance so that it is skipped when popped if a closer hit has been found since.
 
 use super::build::MAX_DEPTH;
-use super::node::{LEAF_BIT, Node4, NodeRay};
+use super::node::{LEAF_BIT, NodeRay, ROBUST_EXIT_SCALE, WIDTH, WideNode};
 
-/// Each 4-wide level pushes at most three siblings and there are at most `MAX_DEPTH`
-/// levels, so this bounds the stack.
-const STACK_SIZE: usize = 3 * MAX_DEPTH as usize + 4;
+/// Each level pushes at most `WIDTH − 1` siblings and there are at most `MAX_DEPTH`
+/// levels, so this bounds the stack of any tree.
+pub(crate) const LARGE_STACK: usize = (WIDTH - 1) * MAX_DEPTH as usize + 4;
+/// The stack for trees of at most `SMALL_STACK_DEPTH` levels: typical trees are shallow,
+/// and zeroing the large stack for every ray costs measurably (~10 % on shadow rays).
+pub(crate) const SMALL_STACK: usize = 96;
+const SMALL_STACK_DEPTH: u32 = (SMALL_STACK as u32 - 1) / (WIDTH as u32 - 1);
+
+/// The flattened wide nodes (node 0 is the root) and whether the small stack suffices.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct NodeTree {
+    nodes: Vec<WideNode>,
+    shallow: bool,
+}
+
+impl NodeTree {
+    pub fn new(nodes: Vec<WideNode>) -> NodeTree {
+        // Children always follow their parent in the array, so one forward pass finds
+        // every node's level.
+        let mut level = vec![1u32; nodes.len()];
+        for i in 0..nodes.len() {
+            for &c in &nodes[i].child {
+                if c & LEAF_BIT == 0 {
+                    level[c as usize] = level[i] + 1;
+                }
+            }
+        }
+        let depth = level.iter().copied().max().unwrap_or(0);
+        NodeTree {
+            nodes,
+            shallow: depth <= SMALL_STACK_DEPTH,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    pub fn nodes(&self) -> &[WideNode] {
+        &self.nodes
+    }
+
+    /// Whether [`SMALL_STACK`] entries suffice. Callers dispatch on this once per query to
+    /// a monomorphised traversal (doing it here would keep the leaf closures from inlining).
+    pub fn shallow(&self) -> bool {
+        self.shallow
+    }
+}
+
+/// What closest-hit traversal does at a leaf: intersect its primitives with hits closer
+/// than `t_max`, and return the new (smaller) `t_max` if there was one. A trait with
+/// `#[inline(always)]` implementations rather than a closure, because LLVM declines to
+/// inline a closure whose body (the SIMD triangle test) is large.
+pub(crate) trait ClosestLeaf {
+    fn visit(&mut self, leaf: u32, t_max: f32) -> Option<f32>;
+    /// Loads the leaf's first data early (a software prefetch in safe Rust).
+    fn touch(&self, _leaf: u32) {}
+}
+
+/// Starts loading every entered child's data at once, so that their cache misses overlap
+/// instead of being taken one after another when each is visited.
+#[inline(always)]
+fn touch_children(nodes: &[WideNode], node: &WideNode, mut mask: u32, touch_leaf: impl Fn(u32)) {
+    while mask != 0 {
+        let c = node.child[mask.trailing_zeros() as usize % WIDTH];
+        mask &= mask - 1;
+        if c & LEAF_BIT == 0 {
+            if let Some(n) = nodes.get(c as usize) {
+                // A word in each cache line of the node (each axis, then the children).
+                for axis in &n.bounds {
+                    std::hint::black_box(axis[0][0].x);
+                }
+                std::hint::black_box(n.child[0]);
+            }
+        } else {
+            touch_leaf(c);
+        }
+    }
+}
+
+/// What any-hit traversal does at a leaf: report whether it holds an occluder.
+pub(crate) trait AnyLeaf {
+    fn visit(&mut self, leaf: u32, t_max: f32) -> bool;
+    /// Loads the leaf's first data early (a software prefetch in safe Rust).
+    fn touch(&self, _leaf: u32) {}
+}
 
 #[derive(Clone, Copy, Default)]
 struct Entry {
@@ -20,14 +103,14 @@ struct Entry {
 }
 
 /// Visits the leaves that may hold a hit closer than `t_max`, nearest first.
-/// `leaf(reference, t_max)` returns the new, smaller `t_max` when it found a hit.
+/// `leaf.visit(reference, t_max)` returns the new, smaller `t_max` when it found a hit.
 /// Returns the final `t_max`.
 #[inline(always)]
-pub(crate) fn closest(
-    nodes: &[Node4],
+pub(crate) fn closest<const STACK_SIZE: usize>(
+    nodes: &[WideNode],
     ray: &NodeRay,
     mut t_max: f32,
-    mut leaf: impl FnMut(u32, f32) -> Option<f32>,
+    leaf: &mut impl ClosestLeaf,
 ) -> f32 {
     if nodes.is_empty() {
         return t_max;
@@ -40,64 +123,65 @@ pub(crate) fn closest(
             let node = &nodes[cur as usize];
             let (mut mask, t_in) = ray.hit(node, t_max);
             if mask != 0 {
-                let t_in = t_in.to_array();
-                let i0 = mask.trailing_zeros() as usize & 3;
+                touch_children(nodes, node, mask, |c| leaf.touch(c));
+                let mut t = [0.0f32; WIDTH];
+                for (g, v) in t_in.iter().enumerate() {
+                    t[4 * g..4 * g + 4].copy_from_slice(&v.to_array());
+                }
+                let i0 = mask.trailing_zeros() as usize % WIDTH;
                 mask &= mask - 1;
                 if mask == 0 {
                     cur = node.child[i0];
                     continue;
                 }
-                let i1 = mask.trailing_zeros() as usize & 3;
+                let i1 = mask.trailing_zeros() as usize % WIDTH;
                 mask &= mask - 1;
                 if mask == 0 {
-                    let (near, far) = if t_in[i0] <= t_in[i1] {
-                        (i0, i1)
-                    } else {
-                        (i1, i0)
-                    };
+                    let (near, far) = if t[i0] <= t[i1] { (i0, i1) } else { (i1, i0) };
                     stack[sp] = Entry {
                         node: node.child[far],
-                        t_in: t_in[far],
+                        t_in: t[far],
                     };
                     sp += 1;
                     cur = node.child[near];
                     continue;
                 }
-                // Three or four children: sort by entry distance (insertion sort).
-                let mut c = [Entry::default(); 4];
-                c[0] = Entry {
-                    node: node.child[i0],
-                    t_in: t_in[i0],
-                };
-                c[1] = Entry {
-                    node: node.child[i1],
-                    t_in: t_in[i1],
-                };
-                let mut k = 2;
-                while mask != 0 {
-                    let i = mask.trailing_zeros() as usize & 3;
-                    mask &= mask - 1;
-                    c[k & 3] = Entry {
+                // Three or more children: sort by entry distance (insertion sort), nearest
+                // last, and push all but the nearest.
+                let mut c = [Entry::default(); WIDTH];
+                let mut k = 0;
+                for i in [i0, i1] {
+                    c[k] = Entry {
                         node: node.child[i],
-                        t_in: t_in[i],
+                        t_in: t[i],
                     };
                     k += 1;
                 }
-                for i in 1..k.min(4) {
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize % WIDTH;
+                    mask &= mask - 1;
+                    c[k % WIDTH] = Entry {
+                        node: node.child[i],
+                        t_in: t[i],
+                    };
+                    k += 1;
+                }
+                let k = k.min(WIDTH);
+                for i in 1..k {
                     let mut j = i;
-                    while j > 0 && c[j - 1].t_in > c[j].t_in {
+                    while j > 0 && c[j - 1].t_in < c[j].t_in {
                         c.swap(j - 1, j);
                         j -= 1;
                     }
                 }
-                for e in c[1..k.min(4)].iter().rev() {
+                for e in &c[..k - 1] {
                     stack[sp] = *e;
                     sp += 1;
                 }
-                cur = c[0].node;
+                cur = c[k - 1].node;
                 continue;
             }
-        } else if let Some(t) = leaf(cur, t_max) {
+        } else if let Some(t) = leaf.visit(cur, t_max) {
             t_max = t;
         }
         // Pop the nearest pending subtree that can still hold a closer hit.
@@ -107,7 +191,8 @@ pub(crate) fn closest(
             }
             sp -= 1;
             let e = stack[sp];
-            if e.t_in <= t_max {
+            // Padded like the box test: t_in may be rounded up by a few ulps.
+            if e.t_in <= t_max * ROBUST_EXIT_SCALE {
                 cur = e.node;
                 break;
             }
@@ -115,13 +200,13 @@ pub(crate) fn closest(
     }
 }
 
-/// Visits leaves until `leaf(reference, t_max)` reports an occluder; returns whether one did.
+/// Visits leaves until `leaf.visit(reference, t_max)` reports an occluder; returns whether one did.
 #[inline(always)]
-pub(crate) fn any(
-    nodes: &[Node4],
+pub(crate) fn any<const STACK_SIZE: usize>(
+    nodes: &[WideNode],
     ray: &NodeRay,
     t_max: f32,
-    mut leaf: impl FnMut(u32, f32) -> bool,
+    leaf: &mut impl AnyLeaf,
 ) -> bool {
     if nodes.is_empty() {
         return false;
@@ -132,18 +217,16 @@ pub(crate) fn any(
     loop {
         if cur & LEAF_BIT == 0 {
             let node = &nodes[cur as usize];
-            let (mut mask, _) = ray.hit(node, t_max);
+            let (mask, _) = ray.hit(node, t_max);
             if mask != 0 {
-                cur = node.child[mask.trailing_zeros() as usize & 3];
-                mask &= mask - 1;
-                while mask != 0 {
-                    stack[sp] = node.child[mask.trailing_zeros() as usize & 3];
-                    sp += 1;
-                    mask &= mask - 1;
+                touch_children(nodes, node, mask, |c| leaf.touch(c));
+                // Branch-free compaction: every child is written, only entered ones count.
+                for (i, &c) in node.child.iter().enumerate() {
+                    stack[sp.min(STACK_SIZE - 1)] = c;
+                    sp += ((mask >> i) & 1) as usize;
                 }
-                continue;
             }
-        } else if leaf(cur, t_max) {
+        } else if leaf.visit(cur, t_max) {
             return true;
         }
         if sp == 0 {

@@ -9,32 +9,32 @@
 use crate::render::geometry::triangle::{WatertightRay, edge_functions_f64};
 use glam::{BVec4A, Vec3, Vec4};
 
-/// Four triangles, vertex coordinates by lane: `v[vertex][axis]`. Unused lanes repeat a
-/// triangle of the same leaf, which changes no result.
+/// Four triangles, vertex coordinates by lane: `v[vertex][axis]` (144 bytes; the triangle
+/// indices live in a parallel array, read once per query for the final hit). Unused lanes
+/// repeat a triangle of the same leaf, which changes no result.
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(32))]
 pub(crate) struct Triangle4 {
     pub v: [[Vec4; 3]; 3],
-    pub prim: [u32; 4],
 }
 
 impl Triangle4 {
-    pub fn new(tris: &[[Vec3; 3]], prims: &[u32]) -> Triangle4 {
+    /// Packs up to four triangles; returns the block and the triangle index of each lane.
+    pub fn new(tris: &[[Vec3; 3]], prims: &[u32]) -> (Triangle4, [u32; 4]) {
         let mut t = Triangle4 {
             v: [[Vec4::ZERO; 3]; 3],
-            prim: [0; 4],
         };
+        let mut lanes = [0; 4];
         let last = tris.len() - 1;
-        for lane in 0..4 {
+        for (lane, prim) in lanes.iter_mut().enumerate() {
             let k = lane.min(last);
             for (vertex, p) in tris[k].iter().enumerate() {
                 for axis in 0..3 {
                     t.v[vertex][axis][lane] = p[axis];
                 }
             }
-            t.prim[lane] = prims[k];
+            *prim = prims[k];
         }
-        t
+        (t, lanes)
     }
 }
 
@@ -63,7 +63,7 @@ pub(crate) struct Lanes {
     pub v: Vec4,
     pub w: Vec4,
     pub t: Vec4,
-    pub inv_det: Vec4,
+    pub det: Vec4,
     pub hit: u32,
 }
 
@@ -86,22 +86,21 @@ pub(crate) fn intersect4(ray: &WatertightRay4, tri: &Triangle4, t_max: f32) -> L
     if zero.any() {
         refine_in_f64(zero, [ax, ay, bx, by, cx, cy], &mut u, &mut v, &mut w);
     }
-    let neg = u.cmplt(Vec4::ZERO) | v.cmplt(Vec4::ZERO) | w.cmplt(Vec4::ZERO);
-    let pos = u.cmpgt(Vec4::ZERO) | v.cmpgt(Vec4::ZERO) | w.cmpgt(Vec4::ZERO);
+    // Mixed edge signs miss: min < 0 < max (the scalar kernel's sign tests, with fewer
+    // operations; lanes with NaN end up with t = NaN and are rejected by the range test).
+    let lo = u.min(v).min(w);
+    let hi = u.max(v).max(w);
     let det = u + v + w;
-    let t_scaled = u * (sz * az) + v * (sz * bz) + w * (sz * cz);
-    let inv_det = Vec4::ONE / det;
-    let t = t_scaled * inv_det;
-    // Lanes with mixed edge signs miss; det = 0 gives t = ±inf or NaN, which the range
-    // test rejects just as the scalar kernel's explicit checks do.
-    let in_range = t.cmpgt(Vec4::ZERO) & t.cmplt(Vec4::splat(t_max)) & det.cmpne(Vec4::ZERO);
-    let hit = in_range.bitmask() & !(neg & pos).bitmask();
+    let t = (u * az + v * bz + w * cz) * (sz / det);
+    // det = 0 gives t = ±∞ or NaN, which the range test rejects, as the scalar kernel does.
+    let in_range = t.cmpgt(Vec4::ZERO) & t.cmplt(Vec4::splat(t_max));
+    let hit = in_range.bitmask() & !(lo.cmplt(Vec4::ZERO) & hi.cmpgt(Vec4::ZERO)).bitmask();
     Lanes {
         u,
         v,
         w,
         t,
-        inv_det,
+        det,
         hit,
     }
 }

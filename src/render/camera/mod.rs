@@ -62,7 +62,8 @@ pub fn from_desc(
 ) -> Result<Camera, crate::scene::SceneError> {
     use crate::scene::{CameraKind, SceneError};
     let world_from_camera = desc.camera_from_world.inverse();
-    let window = |w: &Option<[f32; 4]>| w.unwrap_or_else(|| projective::default_screen_window(resolution));
+    let window =
+        |w: &Option<[f32; 4]>| w.unwrap_or_else(|| projective::default_screen_window(resolution));
     match &desc.kind {
         CameraKind::Perspective {
             fov_deg,
@@ -71,7 +72,10 @@ pub fn from_desc(
             screen_window,
         } => {
             if !(*fov_deg > 0.0 && *fov_deg < 180.0) {
-                return Err(SceneError::at(&desc.loc, format!("fov must lie in (0, 180) degrees, got {fov_deg}")));
+                return Err(SceneError::at(
+                    &desc.loc,
+                    format!("fov must lie in (0, 180) degrees, got {fov_deg}"),
+                ));
             }
             Ok(Camera::Projective(ProjectiveCamera {
                 projection: Projection::Perspective {
@@ -101,7 +105,9 @@ pub fn from_desc(
             aperture_diameter_mm,
             focus_distance,
         } => {
-            let lens_error = |e: realistic::LensError| SceneError::at(&desc.loc, format!("Camera \"realistic\": {e}"));
+            let lens_error = |e: realistic::LensError| {
+                SceneError::at(&desc.loc, format!("Camera \"realistic\": {e}"))
+            };
             let lens = realistic::LensPrescription::from_file(lens_file).map_err(lens_error)?;
             let camera = realistic::RealisticCamera::new(
                 lens,

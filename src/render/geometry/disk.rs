@@ -10,6 +10,7 @@ use crate::math::sampling::concentric_disk;
 use crate::math::{PI, safe_sqrt};
 use glam::{Vec2, Vec3};
 
+/// A disk (annulus, sector) at `height` on the z axis, facing +z, in object space.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Disk {
     pub height: f32,
@@ -23,12 +24,14 @@ pub struct Disk {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DiskHit {
     pub t: f32,
+    /// Hit point, exactly in the disk's plane.
     pub p: Vec3,
     /// u = phi / phi_max; v = (radius − r) / (radius − inner_radius) (1 at the inner edge).
     pub uv: Vec2,
 }
 
 impl Disk {
+    /// pbrt's `disk`: `height`, `radius`, `innerradius`, `phimax` in degrees.
     pub fn new(
         height: f32,
         radius: f32,

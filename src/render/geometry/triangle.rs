@@ -113,16 +113,13 @@ pub fn intersect_triangle(
     if det == 0.0 {
         return None;
     }
-    let t_scaled = u * (ray.sz * a[kz]) + v * (ray.sz * b[kz]) + w * (ray.sz * c[kz]);
-    // t = t_scaled / det must be positive: reject by sign before dividing.
-    if (t_scaled <= 0.0 && det > 0.0) || (t_scaled >= 0.0 && det < 0.0) {
-        return None;
-    }
-    let inv_det = 1.0 / det;
-    let t = t_scaled * inv_det;
+    // The paper scales each vertex's z by Sz; scaling the sum once is the same
+    // t = (U Az + V Bz + W Cz) Sz / det up to rounding, with two fewer multiplies.
+    let t = (u * a[kz] + v * b[kz] + w * c[kz]) * (ray.sz / det);
     if !(t > 0.0 && t < t_max) {
         return None;
     }
+    let inv_det = 1.0 / det;
     Some(TriangleHit {
         t,
         b: [u * inv_det, v * inv_det, w * inv_det],

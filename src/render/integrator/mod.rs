@@ -2,9 +2,15 @@
 //! built on the same world. `Integrator` is chosen by name from the scene (or the
 //! command line) and reads its own parameters.
 
+pub mod direct;
+pub mod footprint;
 pub mod path;
+pub mod photon;
+pub mod sppm;
 
 pub use path::PathSettings;
+pub use photon::{PhotonMapStats, PhotonSettings, Visualize};
+pub use sppm::{SppmSettings, SppmStats};
 
 use crate::scene::{IntegratorDesc, SceneError, Warning};
 
@@ -12,10 +18,35 @@ use crate::scene::{IntegratorDesc, SceneError, Warning};
 #[derive(Clone, Debug, PartialEq)]
 pub enum Integrator {
     Path(PathSettings),
+    /// Two-pass photon mapping with final gathering (`photonmap`; `photonviz` is the
+    /// same with `visualize "density"` by default).
+    PhotonMap(PhotonSettings),
+    /// Stochastic progressive photon mapping.
+    Sppm(SppmSettings),
+}
+
+/// What an integrator reports beyond the image (photon counts, radii, timings).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum IntegratorStats {
+    #[default]
+    None,
+    PhotonMap(PhotonMapStats),
+    Sppm(SppmStats),
+}
+
+impl std::fmt::Display for IntegratorStats {
+    /// Info lines for the command line (empty for integrators without statistics).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            IntegratorStats::None => Ok(()),
+            IntegratorStats::PhotonMap(s) => s.fmt(f),
+            IntegratorStats::Sppm(s) => s.fmt(f),
+        }
+    }
 }
 
 /// Names accepted by `Integrator` and `--integrator`.
-pub const INTEGRATOR_NAMES: [&str; 1] = ["path"];
+pub const INTEGRATOR_NAMES: [&str; 4] = ["path", "photonmap", "photonviz", "sppm"];
 
 impl Integrator {
     /// Chooses the integrator from a scene's `Integrator` directive. Names radiant does
@@ -25,6 +56,11 @@ impl Integrator {
         let mut warnings = Vec::new();
         let integrator = match desc.name.as_str() {
             "path" => Integrator::Path(PathSettings::from_desc(desc)?),
+            "photonmap" => Integrator::PhotonMap(PhotonSettings::from_desc(desc, Visualize::None)?),
+            "photonviz" => {
+                Integrator::PhotonMap(PhotonSettings::from_desc(desc, Visualize::Density)?)
+            }
+            "sppm" => Integrator::Sppm(SppmSettings::from_desc(desc)?),
             "volpath" => {
                 warnings.push(Warning {
                     loc: desc.loc.clone(),
@@ -52,6 +88,9 @@ impl Integrator {
     pub fn name(&self) -> &'static str {
         match self {
             Integrator::Path(_) => "path",
+            Integrator::PhotonMap(s) if s.visualize != Visualize::None => "photonviz",
+            Integrator::PhotonMap(_) => "photonmap",
+            Integrator::Sppm(_) => "sppm",
         }
     }
 }

@@ -13,6 +13,8 @@ use crate::render::sampler::PixelSample;
 use crate::render::world::{NO_LIGHT, World};
 use crate::scene::{IntegratorDesc, SceneError};
 
+use super::direct;
+
 /// `Integrator "path"` parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathSettings {
@@ -42,7 +44,12 @@ impl Default for PathSettings {
 }
 
 /// Radiance along a camera ray; also returns the number of rays traced.
-pub fn radiance(world: &World, settings: &PathSettings, mut ray: Ray, sampler: &mut PixelSample) -> (Rgb, u32) {
+pub fn radiance(
+    world: &World,
+    settings: &PathSettings,
+    mut ray: Ray,
+    sampler: &mut PixelSample,
+) -> (Rgb, u32) {
     let scene = world.scene_sphere();
     let mut l = Rgb::BLACK;
     let mut beta = Rgb::WHITE;
@@ -64,7 +71,8 @@ pub fn radiance(world: &World, settings: &PathSettings, mut ray: Ray, sampler: &
                 let w = if specular_bounce {
                     1.0
                 } else {
-                    let pdf_light = world.light_distribution.pmf(i) * light.pdf_li(prev_p, Vec3::ZERO, Vec3::ZERO);
+                    let pdf_light = world.light_distribution.pmf(i)
+                        * light.pdf_li(prev_p, Vec3::ZERO, Vec3::ZERO, glam::Vec2::ZERO);
                     power_heuristic(prev_pdf, pdf_light)
                 };
                 l += beta * le * w;
@@ -81,8 +89,8 @@ pub fn radiance(world: &World, settings: &PathSettings, mut ray: Ray, sampler: &
                 let w = if specular_bounce {
                     1.0
                 } else {
-                    let pdf_light =
-                        world.light_distribution.pmf(hit.light as usize) * area.pdf_li(prev_p, hit.p, hit.ng);
+                    let pdf_light = world.light_distribution.pmf(hit.light as usize)
+                        * area.pdf_li(prev_p, hit.p, hit.ng, hit.uv);
                     power_heuristic(prev_pdf, pdf_light)
                 };
                 l += beta * le * w;
@@ -97,37 +105,32 @@ pub fn radiance(world: &World, settings: &PathSettings, mut ray: Ray, sampler: &
         let frame = Frame::from_normal(hit.ns);
         let wo = frame.to_local(wo_world);
 
-        if !material.is_specular() && !world.lights.is_empty() {
-            let (light_index, pmf, _) = world.light_distribution.sample(sampler.get_1d());
-            let u_light = sampler.get_2d();
-            if let Some(ls) = world.lights[light_index].sample_li(hit.p, u_light, scene) {
-                let wi = frame.to_local(ls.wi);
-                // Light must arrive on the side the path came from (geometric test
-                // prevents leaks through shading normals).
-                let same_side = ls.wi.dot(hit.ng) * wo_world.dot(hit.ng) > 0.0;
-                let f = material.eval(wo, wi) * wi.z.abs();
-                if same_side && !f.is_black() {
-                    rays += 1;
-                    let unoccluded = if ls.at_infinity {
-                        !world.occluded(&hit.spawn_ray(ls.wi), f32::INFINITY)
-                    } else {
-                        world.visible(hit.p, hit.ng, ls.p, ls.n)
-                    };
-                    if unoccluded {
-                        let light_pdf = pmf * ls.pdf;
-                        let w = if ls.delta {
-                            1.0
-                        } else {
-                            power_heuristic(light_pdf, material.pdf(wo, wi))
-                        };
-                        l += beta * f * ls.li * (w / light_pdf);
-                    }
-                }
+        // Drawn for every vertex so that the dimension layout does not depend on the material.
+        let u_choice = sampler.get_1d();
+        let u_light = sampler.get_2d();
+        if !material.is_specular() {
+            let mut shadow_rays = 0;
+            let ds = direct::sample_direct(
+                world,
+                scene,
+                &hit,
+                &material,
+                &frame,
+                wo,
+                wo_world,
+                u_choice,
+                u_light,
+                &mut shadow_rays,
+            );
+            rays += shadow_rays;
+            if let Some(ds) = ds {
+                let w = if ds.delta {
+                    1.0
+                } else {
+                    power_heuristic(ds.light_pdf, ds.bsdf_pdf)
+                };
+                l += beta * ds.f * ds.li * (w / ds.light_pdf);
             }
-        } else {
-            // Keep the dimension layout independent of the material.
-            sampler.get_1d();
-            sampler.get_2d();
         }
 
         let u_lobe = sampler.get_1d();
@@ -140,11 +143,15 @@ pub fn radiance(world: &World, settings: &PathSettings, mut ray: Ray, sampler: &
             break;
         }
         beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-        if let Material::Dielectric { eta } = material {
-            if wi.dot(hit.ng) * wo_world.dot(hit.ng) < 0.0 {
-                // Refraction: track eta^2 so roulette sees the unscaled throughput.
-                eta_scale *= if wo_world.dot(hit.ng) > 0.0 { eta * eta } else { 1.0 / (eta * eta) };
-            }
+        if let Material::Dielectric { eta } = material
+            && wi.dot(hit.ng) * wo_world.dot(hit.ng) < 0.0
+        {
+            // Refraction: track eta^2 so roulette sees the unscaled throughput.
+            eta_scale *= if wo_world.dot(hit.ng) > 0.0 {
+                eta * eta
+            } else {
+                1.0 / (eta * eta)
+            };
         }
         specular_bounce = bs.specular;
         prev_pdf = bs.pdf;

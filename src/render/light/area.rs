@@ -7,12 +7,13 @@ use glam::{Vec2, Vec3};
 use super::{EmittedRay, LightSample};
 use crate::color::Rgb;
 use crate::math::{Frame, PI, Transform, sampling};
+use crate::render::geometry::Ray;
+use crate::render::geometry::bilinear::BilinearPatch;
 use crate::render::geometry::disk::Disk;
 use crate::render::geometry::ray::offset_origin;
 use crate::render::geometry::sample::{AreaSample, area_pdf_to_solid_angle};
 use crate::render::geometry::sphere::Sphere;
 use crate::render::geometry::triangle::sample_triangle;
-use crate::render::geometry::Ray;
 
 #[derive(Clone, Debug)]
 pub enum LightShape {
@@ -23,6 +24,11 @@ pub enum LightShape {
         sphere: Sphere,
         render_from_object: Transform,
         reverse: bool,
+    },
+    /// A curved bilinear patch in render space; `orientation` −1 flips ∂p/∂u × ∂p/∂v.
+    Bilinear {
+        patch: BilinearPatch,
+        orientation: f32,
     },
     /// A disk placed by a similarity transform; `scale2` is the area scale factor.
     Disk {
@@ -50,6 +56,7 @@ impl AreaLight {
                 ..
             } => sphere.area() * similarity_scale2(render_from_object),
             LightShape::Disk { disk, scale2, .. } => disk.area() * scale2,
+            LightShape::Bilinear { patch, .. } => patch.area(),
         }
     }
 
@@ -72,7 +79,11 @@ impl AreaLight {
         match &self.shape {
             LightShape::Triangle { p, n, area } => {
                 let s = sample_triangle(p[0], p[1], p[2], u)?;
-                Some(AreaSample { p: s.p, n: *n, pdf: 1.0 / area })
+                Some(AreaSample {
+                    p: s.p,
+                    n: *n,
+                    pdf: 1.0 / area,
+                })
             }
             LightShape::Sphere {
                 sphere,
@@ -80,14 +91,31 @@ impl AreaLight {
                 reverse,
             } => {
                 let s = sphere.sample_area(u);
-                Some(to_render(s, render_from_object, *reverse, similarity_scale2(render_from_object)))
+                Some(to_render(
+                    s,
+                    render_from_object,
+                    *reverse,
+                    similarity_scale2(render_from_object),
+                ))
             }
             LightShape::Disk {
                 disk,
                 render_from_object,
                 reverse,
                 scale2,
-            } => Some(to_render(disk.sample_area(u), render_from_object, *reverse, *scale2)),
+            } => Some(to_render(
+                disk.sample_area(u),
+                render_from_object,
+                *reverse,
+                *scale2,
+            )),
+            LightShape::Bilinear { patch, orientation } => {
+                let s = patch.sample_area(u)?;
+                Some(AreaSample {
+                    n: s.n * *orientation,
+                    ..s
+                })
+            }
         }
     }
 
@@ -131,8 +159,9 @@ impl AreaLight {
         })
     }
 
-    /// Solid-angle density of `sample_li` from `p` for the light point `q` (normal `n`).
-    pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3) -> f32 {
+    /// Solid-angle density of `sample_li` from `p` for the light point `q` (normal `n`,
+    /// surface parameters `uv`).
+    pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3, uv: Vec2) -> f32 {
         match &self.shape {
             LightShape::Sphere {
                 sphere,
@@ -141,6 +170,9 @@ impl AreaLight {
             } => {
                 let inv = render_from_object.inverse();
                 sphere.pdf_solid_angle(inv.point(p), inv.point(q))
+            }
+            LightShape::Bilinear { patch, .. } => {
+                area_pdf_to_solid_angle(patch.pdf_area(uv), p, q, n)
             }
             _ => area_pdf_to_solid_angle(1.0 / self.area(), p, q, n),
         }
@@ -174,7 +206,10 @@ impl AreaLight {
 
 /// Area scale factor of a similarity transform: |det|^(2/3).
 fn similarity_scale2(xf: &Transform) -> f32 {
-    glam::Mat3::from_mat4(xf.m).determinant().abs().powf(2.0 / 3.0)
+    glam::Mat3::from_mat4(xf.m)
+        .determinant()
+        .abs()
+        .powf(2.0 / 3.0)
 }
 
 fn to_render(s: AreaSample, xf: &Transform, reverse: bool, scale2: f32) -> AreaSample {

@@ -12,7 +12,12 @@ use crate::render::geometry::Ray;
 /// Uniform sphere sampling: the density of every direction.
 pub(super) const PDF: f32 = sampling::UNIFORM_SPHERE_PDF;
 
-pub(super) fn sample_li(p: Vec3, radiance: Rgb, u: Vec2, scene: SceneSphere) -> Option<LightSample> {
+pub(super) fn sample_li(
+    p: Vec3,
+    radiance: Rgb,
+    u: Vec2,
+    scene: SceneSphere,
+) -> Option<LightSample> {
     let wi = sampling::uniform_sphere(u);
     Some(LightSample {
         li: radiance,
@@ -27,7 +32,12 @@ pub(super) fn sample_li(p: Vec3, radiance: Rgb, u: Vec2, scene: SceneSphere) -> 
 
 /// A ray travelling along `direction` through a uniformly chosen point of the disk
 /// that covers the scene; power = radiance * disk area.
-pub(super) fn emit_parallel(direction: Vec3, radiance: Rgb, u: Vec2, scene: SceneSphere) -> EmittedRay {
+pub(super) fn emit_parallel(
+    direction: Vec3,
+    radiance: Rgb,
+    u: Vec2,
+    scene: SceneSphere,
+) -> EmittedRay {
     let frame = Frame::from_normal(direction);
     let d = sampling::concentric_disk(u) * scene.radius;
     let origin = scene.center + frame.to_world(Vec3::new(d.x, d.y, 0.0)) - direction * scene.radius;

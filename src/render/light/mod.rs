@@ -56,7 +56,10 @@ pub struct SceneSphere {
 pub enum Light {
     Area(AreaLight),
     /// Isotropic point light; `intensity` in W/sr.
-    Point { position: Vec3, intensity: Rgb },
+    Point {
+        position: Vec3,
+        intensity: Rgb,
+    },
     /// pbrt-v4 spot light: full intensity inside `cos_falloff_start`, a smoothstep to
     /// zero at `cos_total_width`.
     Spot {
@@ -68,14 +71,22 @@ pub enum Light {
     },
     /// Parallel light travelling along `direction`, radiance-scale `radiance`
     /// (irradiance on a perpendicular surface).
-    Distant { direction: Vec3, radiance: Rgb },
+    Distant {
+        direction: Vec3,
+        radiance: Rgb,
+    },
     /// Constant radiance from every direction.
-    Infinite { radiance: Rgb },
+    Infinite {
+        radiance: Rgb,
+    },
 }
 
 impl Light {
     pub fn is_delta(&self) -> bool {
-        matches!(self, Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. })
+        matches!(
+            self,
+            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
+        )
     }
 
     /// Emitted power (flux), used to choose lights in proportion to it.
@@ -90,14 +101,19 @@ impl Light {
                 ..
             } => *intensity * (2.0 * PI * (1.0 - 0.5 * (cos_falloff_start + cos_total_width))),
             Light::Distant { radiance, .. } => *radiance * (PI * scene.radius * scene.radius),
-            Light::Infinite { radiance } => *radiance * (4.0 * PI * PI * scene.radius * scene.radius),
+            Light::Infinite { radiance } => {
+                *radiance * (4.0 * PI * PI * scene.radius * scene.radius)
+            }
         }
     }
 
     pub fn sample_li(&self, p: Vec3, u: Vec2, scene: SceneSphere) -> Option<LightSample> {
         match self {
             Light::Area(a) => a.sample_li(p, u),
-            Light::Point { position, intensity } => point::sample_point(p, *position, *intensity),
+            Light::Point {
+                position,
+                intensity,
+            } => point::sample_point(p, *position, *intensity),
             Light::Spot {
                 position,
                 direction,
@@ -106,10 +122,14 @@ impl Light {
                 cos_total_width,
             } => {
                 let mut s = point::sample_point(p, *position, *intensity)?;
-                s.li *= point::spot_falloff(-s.wi, *direction, *cos_falloff_start, *cos_total_width);
+                s.li *=
+                    point::spot_falloff(-s.wi, *direction, *cos_falloff_start, *cos_total_width);
                 (!s.li.is_black()).then_some(s)
             }
-            Light::Distant { direction, radiance } => Some(LightSample {
+            Light::Distant {
+                direction,
+                radiance,
+            } => Some(LightSample {
                 li: *radiance,
                 wi: -*direction,
                 p: p - *direction * (2.0 * scene.radius + (p - scene.center).length()),
@@ -123,10 +143,11 @@ impl Light {
     }
 
     /// Solid-angle density with which `sample_li` from `p` would have produced the
-    /// direction towards point `q` (normal `n`) on this light. Zero for delta lights.
-    pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3) -> f32 {
+    /// direction towards point `q` (normal `n`, surface parameters `uv`) on this light.
+    /// Zero for delta lights.
+    pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3, uv: Vec2) -> f32 {
         match self {
-            Light::Area(a) => a.pdf_li(p, q, n),
+            Light::Area(a) => a.pdf_li(p, q, n, uv),
             Light::Infinite { .. } => infinite::PDF,
             _ => 0.0,
         }
@@ -140,20 +161,36 @@ impl Light {
         }
     }
 
-    pub fn sample_emission(&self, u_pos: Vec2, u_dir: Vec2, scene: SceneSphere) -> Option<EmittedRay> {
+    pub fn sample_emission(
+        &self,
+        u_pos: Vec2,
+        u_dir: Vec2,
+        scene: SceneSphere,
+    ) -> Option<EmittedRay> {
         match self {
             Light::Area(a) => a.sample_emission(u_pos, u_dir),
-            Light::Point { position, intensity } => Some(point::emit_point(*position, *intensity, u_dir)),
+            Light::Point {
+                position,
+                intensity,
+            } => Some(point::emit_point(*position, *intensity, u_dir)),
             Light::Spot {
                 position,
                 direction,
                 intensity,
                 cos_falloff_start,
                 cos_total_width,
-            } => point::emit_spot(*position, *direction, *intensity, *cos_falloff_start, *cos_total_width, u_dir),
-            Light::Distant { direction, radiance } => {
-                Some(infinite::emit_parallel(*direction, *radiance, u_pos, scene))
-            }
+            } => point::emit_spot(
+                *position,
+                *direction,
+                *intensity,
+                *cos_falloff_start,
+                *cos_total_width,
+                u_dir,
+            ),
+            Light::Distant {
+                direction,
+                radiance,
+            } => Some(infinite::emit_parallel(*direction, *radiance, u_pos, scene)),
             Light::Infinite { radiance } => {
                 let d = -crate::math::sampling::uniform_sphere(u_dir);
                 let mut e = infinite::emit_parallel(d, *radiance, u_pos, scene);

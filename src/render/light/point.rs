@@ -25,7 +25,12 @@ pub(super) fn sample_point(p: Vec3, position: Vec3, intensity: Rgb) -> Option<Li
 }
 
 /// pbrt-v4's spot profile: 1 inside the falloff start, smoothstep to 0 at the edge.
-pub(super) fn spot_falloff(w: Vec3, axis: Vec3, cos_falloff_start: f32, cos_total_width: f32) -> f32 {
+pub(super) fn spot_falloff(
+    w: Vec3,
+    axis: Vec3,
+    cos_falloff_start: f32,
+    cos_total_width: f32,
+) -> f32 {
     let cos = w.dot(axis);
     if cos >= cos_falloff_start {
         return 1.0;

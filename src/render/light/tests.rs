@@ -73,7 +73,11 @@ fn rectangle_light_irradiance_matches_the_corner_form_factor() {
         e += m;
         var += se * se;
     }
-    assert!((e - exact).abs() < 4.0 * var.sqrt() + 1e-6, "{e} vs {exact} (se {})", var.sqrt());
+    assert!(
+        (e - exact).abs() < 4.0 * var.sqrt() + 1e-6,
+        "{e} vs {exact} (se {})",
+        var.sqrt()
+    );
 }
 
 #[test]
@@ -94,7 +98,7 @@ fn sphere_light_irradiance_is_pi_l_sin2() {
     let mut rng = Pcg32::new(1, 1);
     for _ in 0..100 {
         let s = light.sample_li(Vec3::ZERO, u2(&mut rng), scene()).unwrap();
-        let pdf = light.pdf_li(Vec3::ZERO, s.p, s.n);
+        let pdf = light.pdf_li(Vec3::ZERO, s.p, s.n, Vec2::ZERO);
         assert!((pdf - s.pdf).abs() < 1e-3 * s.pdf, "{pdf} vs {}", s.pdf);
     }
 }
@@ -106,7 +110,7 @@ fn triangle_light_pdf_li_matches_its_samples() {
     let mut rng = Pcg32::new(2, 2);
     for _ in 0..100 {
         let s = light.sample_li(p, u2(&mut rng), scene()).unwrap();
-        let pdf = light.pdf_li(p, s.p, s.n);
+        let pdf = light.pdf_li(p, s.p, s.n, Vec2::ZERO);
         assert!((pdf - s.pdf).abs() < 1e-3 * s.pdf);
     }
 }
@@ -149,6 +153,9 @@ fn emitted_power_equals_light_power() {
         let mean = s / n as f64;
         let se = ((s2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
         let power = light.power(scene()).g as f64;
-        assert!((mean - power).abs() < 4.0 * se + 1e-6 * power, "{light:?}: {mean} vs {power}");
+        assert!(
+            (mean - power).abs() < 4.0 * se + 1e-6 * power,
+            "{light:?}: {mean} vs {power}"
+        );
     }
 }

@@ -14,7 +14,7 @@ use glam::Vec2;
 use crate::math::hash::{hash_u64s, mix64, u32_to_unit_f32};
 use crate::scene::SamplerKind;
 
-pub use sobol::{owen_scramble, sobol_u32};
+pub use sobol::{owen_scramble, scrambled_sobol, sobol_u32};
 
 /// The sampler state for one pixel sample.
 #[derive(Clone, Debug)]
@@ -70,7 +70,7 @@ impl PixelSample {
             SamplerKind::Independent => u32_to_unit_f32(mix64(key ^ self.index as u64) as u32),
             SamplerKind::Sobol => {
                 let i = shuffled_index(self.index, key);
-                u32_to_unit_f32(owen_scramble(sobol_u32(0, i), (key >> 32) as u32))
+                u32_to_unit_f32(scrambled_sobol(0, i, (key >> 32) as u32))
             }
         }
     }
@@ -87,8 +87,8 @@ impl PixelSample {
                 let i = shuffled_index(self.index, key);
                 let h = mix64(key);
                 Vec2::new(
-                    u32_to_unit_f32(owen_scramble(sobol_u32(0, i), h as u32)),
-                    u32_to_unit_f32(owen_scramble(sobol_u32(1, i), (h >> 32) as u32)),
+                    u32_to_unit_f32(scrambled_sobol(0, i, h as u32)),
+                    u32_to_unit_f32(scrambled_sobol(1, i, (h >> 32) as u32)),
                 )
             }
         }

@@ -50,18 +50,56 @@ const fn sobol1_byte_tables() -> [[u32; 256]; 4] {
     tables
 }
 
-/// Nested uniform (Owen) scrambling of a 32-bit fraction by a hash, after Laine &
-/// Karras (2011) and Burley (JCGT 2020): a hash that only propagates bits upward,
-/// applied to the bit-reversed value, flips each bit depending only on the bits above
-/// it. The constants are N. Vegdahl's improved hash ("Building a Better LK Hash", 2021).
-pub fn owen_scramble(v: u32, seed: u32) -> u32 {
-    let mut x = v.reverse_bits();
+/// Owen-scrambled Sobol point `index` of dimension `dim` (0 or 1). The scramble works
+/// on the bit-reversed fraction, and the reversed Sobol value is cheap to form
+/// directly (dimension 0 reversed is the index itself; dimension 1 from reversed
+/// tables), which saves two bit reversals per value.
+#[inline]
+pub fn scrambled_sobol(dim: u32, index: u32, seed: u32) -> u32 {
+    let reversed = match dim {
+        0 => index,
+        _ => {
+            let b = index.to_le_bytes();
+            SOBOL1_BYTES_REVERSED[0][b[0] as usize]
+                ^ SOBOL1_BYTES_REVERSED[1][b[1] as usize]
+                ^ SOBOL1_BYTES_REVERSED[2][b[2] as usize]
+                ^ SOBOL1_BYTES_REVERSED[3][b[3] as usize]
+        }
+    };
+    laine_karras(reversed, seed).reverse_bits()
+}
+
+static SOBOL1_BYTES_REVERSED: [[u32; 256]; 4] = {
+    let mut t = sobol1_byte_tables();
+    let mut byte = 0;
+    while byte < 4 {
+        let mut v = 0;
+        while v < 256 {
+            t[byte][v] = t[byte][v].reverse_bits();
+            v += 1;
+        }
+        byte += 1;
+    }
+    t
+};
+
+/// The Laine–Karras style hash: each output bit depends only on itself and lower bits.
+#[inline]
+fn laine_karras(mut x: u32, seed: u32) -> u32 {
     x ^= x.wrapping_mul(0x3d20_adea);
     x = x.wrapping_add(seed);
     x = x.wrapping_mul((seed >> 16) | 1);
     x ^= x.wrapping_mul(0x0552_6c56);
     x ^= x.wrapping_mul(0x53a2_2864);
-    x.reverse_bits()
+    x
+}
+
+/// Nested uniform (Owen) scrambling of a 32-bit fraction by a hash, after Laine &
+/// Karras (2011) and Burley (JCGT 2020): a hash that only propagates bits upward,
+/// applied to the bit-reversed value, flips each bit depending only on the bits above
+/// it. The constants are N. Vegdahl's improved hash ("Building a Better LK Hash", 2021).
+pub fn owen_scramble(v: u32, seed: u32) -> u32 {
+    laine_karras(v.reverse_bits(), seed).reverse_bits()
 }
 
 #[cfg(test)]
@@ -90,6 +128,20 @@ mod tests {
         for (i, e) in expect.iter().enumerate() {
             let v = sobol_u32(1, i as u32) as f64 / 4_294_967_296.0;
             assert_eq!(v, *e, "index {i}");
+        }
+    }
+
+    #[test]
+    fn fused_scrambled_sobol_equals_scramble_of_sobol() {
+        for dim in 0..2 {
+            for i in [0u32, 1, 7, 300, 65_537, 0x8000_0001] {
+                for seed in [0u32, 0x1234_5678, u32::MAX] {
+                    assert_eq!(
+                        scrambled_sobol(dim, i, seed),
+                        owen_scramble(sobol_u32(dim, i), seed)
+                    );
+                }
+            }
         }
     }
 

@@ -3,13 +3,12 @@
 
 use glam::{Mat3, Vec2, Vec3};
 
-use super::shapes::{Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr};
+use super::shapes::{BilinearPrim, Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr};
 use super::{NO_LIGHT, World};
 use crate::math::{Distribution1D, Transform};
-use crate::render::accel::Bvh;
+use crate::render::geometry::bilinear::BilinearPatch;
 use crate::render::geometry::disk::Disk;
 use crate::render::geometry::sphere::Sphere;
-use crate::render::geometry::Aabb;
 use crate::render::light::{AreaLight, Light, LightShape, SceneSphere};
 use crate::render::material::Material;
 use crate::scene::{AreaLightDesc, Geometry, LightDesc, SceneDesc, SceneError, ShapeDesc, Warning};
@@ -32,13 +31,19 @@ impl World {
                 // pbrt does not support area lights in instances either; the parser warned.
                 add_shape(&mut set, shape, &materials, None, &mut warnings)?;
             }
-            finish(&mut set, &[]);
+            set.finish(&[]);
             prototypes.push(set);
         }
 
         let mut top = ShapeSet::default();
         for shape in &desc.shapes {
-            add_shape(&mut top, shape, &materials, Some(&mut lights), &mut warnings)?;
+            add_shape(
+                &mut top,
+                shape,
+                &materials,
+                Some(&mut lights),
+                &mut warnings,
+            )?;
         }
         for inst in &desc.instances {
             if prototypes[inst.object].is_empty() {
@@ -51,8 +56,8 @@ impl World {
             });
             top.prims.push(PrimRef::Instance(i));
         }
-        finish(&mut top, &prototypes);
-        let bounds = top.bvh.bounds();
+        top.finish(&prototypes);
+        let bounds = top.bounds();
 
         let mut world = World {
             geometry: top,
@@ -66,7 +71,11 @@ impl World {
         for l in &desc.lights {
             world.lights.push(light_from_desc(l));
         }
-        let powers: Vec<f32> = world.lights.iter().map(|l| l.power(scene).average()).collect();
+        let powers: Vec<f32> = world
+            .lights
+            .iter()
+            .map(|l| l.power(scene).average())
+            .collect();
         world.light_distribution = Distribution1D::new(&powers);
         Ok((world, warnings))
     }
@@ -81,14 +90,13 @@ impl World {
     }
 }
 
-fn finish(set: &mut ShapeSet, prototypes: &[ShapeSet]) {
-    let bounds: Vec<Aabb> = set.prim_bounds(prototypes);
-    set.bvh = Bvh::build(&bounds);
-}
-
 fn light_from_desc(l: &LightDesc) -> Light {
     match l {
-        LightDesc::Point { position, intensity, .. } => Light::Point {
+        LightDesc::Point {
+            position,
+            intensity,
+            ..
+        } => Light::Point {
             position: *position,
             intensity: *intensity,
         },
@@ -106,11 +114,17 @@ fn light_from_desc(l: &LightDesc) -> Light {
             cos_falloff_start: *cos_falloff_start,
             cos_total_width: *cos_total_width,
         },
-        LightDesc::Distant { direction, radiance, .. } => Light::Distant {
+        LightDesc::Distant {
+            direction,
+            radiance,
+            ..
+        } => Light::Distant {
             direction: direction.normalize(),
             radiance: *radiance,
         },
-        LightDesc::Infinite { radiance, .. } => Light::Infinite { radiance: *radiance },
+        LightDesc::Infinite { radiance, .. } => Light::Infinite {
+            radiance: *radiance,
+        },
     }
 }
 
@@ -135,7 +149,10 @@ fn add_shape(
 ) -> Result<(), BuildError> {
     let material = shape.material;
     if materials.get(material as usize).is_none() {
-        return Err(SceneError::at(&shape.loc, format!("material index {material} out of range")));
+        return Err(SceneError::at(
+            &shape.loc,
+            format!("material index {material} out of range"),
+        ));
     }
     let emission = match lights {
         Some(lights) => shape.area_light.clone().map(|a| (a, lights)),
@@ -153,32 +170,59 @@ fn add_shape(
             indices,
             normals,
             uvs,
-        } => add_mesh(set, shape, positions, indices.clone(), normals, uvs, emission),
+        } => add_mesh(
+            set,
+            shape,
+            positions,
+            indices.clone(),
+            normals,
+            uvs,
+            emission,
+        ),
         Geometry::BilinearMesh {
             positions,
             indices,
             normals,
             uvs,
         } => {
-            // Each patch (p00, p10, p01, p11) as two triangles: exact for planar patches.
+            // Planar patches (p00, p10, p01, p11) become the triangles (p00,p10,p11),
+            // (p00,p11,p01) — exactly what the patch intersector does for them — so they
+            // share the triangle BVH; curved ones stay patches (Reshetov 2019).
+            let orientation = if ro ^ xf.swaps_handedness() {
+                -1.0
+            } else {
+                1.0
+            };
             let mut tris = Vec::with_capacity(indices.len() / 4 * 6);
-            let mut curved = 0usize;
+            let mut emission = emission;
             for q in indices.chunks_exact(4) {
                 let [a, b, c, d] = [q[0], q[1], q[2], q[3]];
-                tris.extend_from_slice(&[a, b, d, a, d, c]);
-                let p = [a, b, c, d].map(|i| positions[i as usize]);
-                let n = (p[1] - p[0]).cross(p[2] - p[0]);
-                let off = n.normalize_or_zero().dot(p[3] - p[0]).abs();
-                if off > 1e-4 * (p[3] - p[0]).length().max(1e-20) {
-                    curved += 1;
+                let [p00, p10, p01, p11] = [a, b, c, d].map(|i| xf.point(positions[i as usize]));
+                let patch = BilinearPatch::new(p00, p10, p01, p11);
+                if patch.is_planar() {
+                    tris.extend_from_slice(&[a, b, d, a, d, c]);
+                    continue;
                 }
+                let light = match &mut emission {
+                    Some((desc, lights)) => {
+                        push_light(lights, desc, LightShape::Bilinear { patch, orientation })
+                    }
+                    None => NO_LIGHT,
+                };
+                let i = set.bilinears.len() as u32;
+                set.bilinears.push(BilinearPrim {
+                    patch,
+                    material,
+                    light,
+                    orientation,
+                });
+                set.prims.push(PrimRef::Bilinear(i));
             }
-            if curved > 0 {
+            if normals.is_some() && !set.bilinears.is_empty() {
                 warnings.push(Warning {
                     loc: shape.loc.clone(),
-                    message: format!(
-                        "{curved} non-planar bilinear patch(es) approximated by two triangles each"
-                    ),
+                    message: "shading normals on curved bilinear patches are not interpolated; geometric normals are used"
+                        .into(),
                 });
             }
             add_mesh(set, shape, positions, tris, normals, uvs, emission)
@@ -281,7 +325,11 @@ fn add_mesh(
 ) {
     let xf = shape.render_from_object;
     let ro = shape.reverse_orientation;
-    let orientation = if ro ^ xf.swaps_handedness() { -1.0 } else { 1.0 };
+    let orientation = if ro ^ xf.swaps_handedness() {
+        -1.0
+    } else {
+        1.0
+    };
     let p: Vec<Vec3> = positions.iter().map(|&v| xf.point(v)).collect();
     // pbrt-v4 flips per-vertex normals under ReverseOrientation.
     let n: Option<Vec<Vec3>> = normals.as_ref().map(|ns| {
@@ -305,17 +353,26 @@ fn add_mesh(
                     // With shading normals the front follows them (pbrt-v4), else the winding.
                     let mut front = cross.normalize();
                     match &n {
-                        Some(ns) if (ns[v[0]] + ns[v[1]] + ns[v[2]]).dot(front) < 0.0 => front = -front,
+                        Some(ns) if (ns[v[0]] + ns[v[1]] + ns[v[2]]).dot(front) < 0.0 => {
+                            front = -front
+                        }
                         Some(_) => {}
                         None => front *= orientation,
                     }
-                    push_light(lights, a, LightShape::Triangle { p: pts, n: front, area })
+                    push_light(
+                        lights,
+                        a,
+                        LightShape::Triangle {
+                            p: pts,
+                            n: front,
+                            area,
+                        },
+                    )
                 } else {
                     NO_LIGHT
                 }
             }
         };
-        let i = set.triangles.len() as u32;
         set.triangles.push(pts);
         set.triangle_attrs.push(TriangleAttr {
             mesh,
@@ -324,7 +381,6 @@ fn add_mesh(
             light,
             orientation,
         });
-        set.prims.push(PrimRef::Triangle(i));
     }
     set.meshes.push(MeshAttrs {
         indices,

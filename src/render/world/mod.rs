@@ -13,7 +13,6 @@ pub use build::BuildError;
 pub use shapes::ShapeSet;
 
 use crate::math::Distribution1D;
-use crate::render::accel::Bvh;
 use crate::render::geometry::ray::offset_origin;
 use crate::render::geometry::{Aabb, Ray};
 use crate::render::light::Light;
@@ -85,8 +84,15 @@ impl World {
         !self.occluded(&Ray::new(o, d), 1.0 - 1e-4)
     }
 
-    pub fn accel(&self) -> &Bvh {
-        &self.geometry.bvh
+    /// Bounding spheres (centre, radius) of the specular geometry (mirrors, conductors,
+    /// glass): one per mesh, quadric or instance that has any.
+    pub fn specular_bounds(&self) -> Vec<(Vec3, f32)> {
+        let pick = |m: u32| {
+            let m = &self.materials[m as usize];
+            m.is_specular() && *m != Material::Interface
+        };
+        self.geometry
+            .bounding_spheres_where(&self.prototypes, &pick)
     }
 
     /// Centre and radius of a sphere enclosing the scene (for distant and infinite lights).

@@ -123,13 +123,14 @@ impl LensSystem {
         }
         let mut warning = None;
         let mut d = diameter_mm;
-        if d > self.file_stop_diameter {
+        // Scene files store f32: a diameter equal to the stop's up to f32 rounding is the stop.
+        if d > self.file_stop_diameter * (1.0 + 1e-6) {
             warning = Some(format!(
                 "{}: aperture diameter {diameter_mm} mm is larger than the lens's stop ({} mm); clamped",
                 self.name, self.file_stop_diameter
             ));
-            d = self.file_stop_diameter;
         }
+        d = d.min(self.file_stop_diameter);
         self.interfaces[self.stop].aperture_radius = 0.5 * d;
         Ok(warning)
     }

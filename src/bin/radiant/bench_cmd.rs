@@ -1,0 +1,54 @@
+//! `radiant bench`: throughput figures (never part of the tests).
+
+use clap::Args;
+use radiant::render::accel::{RayBenchConfig, ray_benchmark};
+use radiant::render::bench::{render_benchmark, world_ray_benchmark};
+use radiant::render::integrator::photon::bench::photon_benchmark;
+use radiant::scene::builtin::cornell_box;
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Smaller workloads, for a quick look (the figures are then less stable).
+    #[arg(long)]
+    pub quick: bool,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Samples per pixel of the timed cornell-box render.
+    #[arg(long, default_value_t = 256)]
+    pub spp: u32,
+}
+
+pub fn run(args: BenchArgs) -> anyhow::Result<()> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()?;
+    pool.install(|| {
+        let reps = if args.quick { 2 } else { 5 };
+        println!("== rays through the world, cornell-box (36 triangles), 1024x1024 camera");
+        println!(
+            "{}",
+            world_ray_benchmark(&cornell_box(), if args.quick { 256 } else { 1024 }, reps)
+        );
+        println!("== rays, displaced sphere of ~1M triangles inside the Cornell box");
+        let config = RayBenchConfig {
+            subdivision: if args.quick { 64 } else { 224 },
+            image_size: if args.quick { 256 } else { 1024 },
+            repetitions: reps,
+            ..Default::default()
+        };
+        println!("{}", ray_benchmark(&config));
+        println!(
+            "== render cornell-box 256x256, {} spp, path tracer",
+            args.spp
+        );
+        let (seconds, _) = render_benchmark(&cornell_box(), args.spp);
+        println!(
+            "{seconds:.2} s wall on {} threads",
+            rayon::current_num_threads()
+        );
+        println!("== photon mapping, cornell-caustics");
+        println!("{}", photon_benchmark(args.quick));
+    });
+    Ok(())
+}

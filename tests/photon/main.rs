@@ -1,0 +1,11 @@
+//! Photon mapping and stochastic progressive photon mapping: stored energy,
+//! projection maps, the furnace, the cornell-caustics reference, the spot-lit caustic
+//! the path tracer cannot render, visualisations, snapshots, cancellation,
+//! determinism and parameters.
+
+#[path = "../common/mod.rs"]
+mod common;
+mod maps;
+mod photonmap;
+mod scenes;
+mod sppm;
