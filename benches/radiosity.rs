@@ -2,18 +2,27 @@
 //! ray-cast factors, and full-matrix factors (ray casting, hemi-cube) with the
 //! iterative solvers on about 2,000 patches.
 //!
+//! The Cornell-box benchmarks run the whole integrator path on the canonical scene
+//! with its blocks (meshing excluded): shadow rays through the face BVH.
+//!
 //! Run: `cargo bench --bench radiosity` (`RAYON_NUM_THREADS=2` to match the target
-//! machine).
+//! machine); one case: `cargo bench --bench radiosity -- cornell_progressive`.
 
 use std::ops::ControlFlow;
 
 use divan::Bencher;
+use radiant::radiosity::scene::RadiosityScene;
+use radiant::radiosity::settings::{FormFactorMethod, RadiositySettings, SolverKind};
 use radiant::radiosity::shapes::cornell_like_box;
+use radiant::radiosity::solve::solve;
+use radiant::radiosity::world_visibility::FaceVisibility;
 use radiant::radiosity::{
     AlwaysVisible, FormFactorMatrix, HemiCube, IterationSettings, PatchSet, ProgressiveSettings,
     RayCastSettings, RayCaster, ShootingFactors, solve_gauss_seidel, solve_jacobi,
     solve_progressive,
 };
+use radiant::render::world::World;
+use radiant::scene::builtin::cornell_box;
 
 fn main() {
     divan::main();
@@ -84,4 +93,87 @@ fn gauss_seidel_1944_patches(bencher: Bencher) {
 fn jacobi_1944_patches(bencher: Bencher) {
     let (set, f) = solver_input();
     bencher.bench_local(|| solve_jacobi(&set, &f, SOLVE_TO_1E6, |_, _| {}));
+}
+
+/// The canonical Cornell box (blocks included) meshed with patches of at most
+/// `max_patch_area` mm^2.
+fn cornell_scene(
+    max_patch_area: f64,
+    settings: RadiositySettings,
+) -> (RadiosityScene, RadiositySettings) {
+    let settings = RadiositySettings {
+        max_patch_area: Some(max_patch_area),
+        ..settings
+    };
+    let scene =
+        RadiosityScene::from_desc(&cornell_box(), &settings).expect("canonical scene meshes");
+    (scene, settings)
+}
+
+/// 10,082 patches.
+const CORNELL_10K_AREA: f64 = 230.0;
+/// 2,058 patches.
+const CORNELL_2K_AREA: f64 = 1200.0;
+
+/// Solves and checks convergence; returns (patches, shots or sweeps).
+fn solve_cornell(scene: &RadiosityScene, settings: &RadiositySettings) -> (usize, usize) {
+    let (world, _) = World::build(&cornell_box()).expect("canonical scene builds");
+    let vis = FaceVisibility::new(scene);
+    let solution = solve(
+        scene,
+        &world.lights,
+        world.scene_sphere(),
+        settings,
+        &vis,
+        |_| ControlFlow::Continue(()),
+    )
+    .expect("consistent inputs");
+    assert!(solution.converged);
+    (scene.patches.len(), solution.iterations)
+}
+
+/// Progressive refinement on the Cornell box with its blocks, 10^4 patches, to 1 %
+/// unshot power: one-point contour factors at the receivers and one shadow ray each,
+/// tested against the shot's shaft-culled occluders (the blocks and the light).
+#[divan::bench(sample_count = 1, sample_size = 1)]
+fn cornell_progressive_10k_patches_to_1_percent(bencher: Bencher) {
+    let (scene, settings) = cornell_scene(
+        CORNELL_10K_AREA,
+        RadiositySettings {
+            tolerance: 0.01,
+            ..RadiositySettings::default()
+        },
+    );
+    bencher.bench_local(|| solve_cornell(&scene, &settings));
+}
+
+/// The full-matrix path on 2,058 patches: ray-cast factors (2 x 2 points per receiver,
+/// a shadow ray each), then Gauss-Seidel to 1e-6.
+#[divan::bench(sample_count = 1, sample_size = 1)]
+fn cornell_2k_raycast_matrix_gauss_seidel(bencher: Bencher) {
+    let (scene, settings) = cornell_scene(
+        CORNELL_2K_AREA,
+        RadiositySettings {
+            solver: SolverKind::GaussSeidel,
+            tolerance: 1e-6,
+            ..RadiositySettings::default()
+        },
+    );
+    bencher.bench_local(|| solve_cornell(&scene, &settings));
+}
+
+/// The same with a 128-cell hemi-cube per patch (its depth buffer resolves occlusion).
+#[divan::bench(sample_count = 1, sample_size = 1)]
+fn cornell_2k_hemicube_matrix_gauss_seidel(bencher: Bencher) {
+    let (scene, settings) = cornell_scene(
+        CORNELL_2K_AREA,
+        RadiositySettings {
+            solver: SolverKind::GaussSeidel,
+            form_factor: FormFactorMethod::HemiCube,
+            hemicube_resolution: 128,
+            tolerance: 1e-6,
+            ..RadiositySettings::default()
+        },
+    );
+    bencher.bench_local(|| solve_cornell(&scene, &settings));
 }

@@ -71,7 +71,11 @@ impl FaceMesh {
     /// The index of the point at `p`, adding it unless an identical one exists.
     pub fn point(&mut self, p: DVec3) -> u32 {
         // `+ 0.0` turns -0 into +0 so both weld.
-        let key = [(p.x + 0.0).to_bits(), (p.y + 0.0).to_bits(), (p.z + 0.0).to_bits()];
+        let key = [
+            (p.x + 0.0).to_bits(),
+            (p.y + 0.0).to_bits(),
+            (p.z + 0.0).to_bits(),
+        ];
         let next = self.points.len() as u32;
         let index = *self.weld.entry(key).or_insert(next);
         if index == next {
@@ -202,7 +206,11 @@ impl FaceMesh {
                     edges.chain(a, b, &edge_points)
                 })
                 .collect();
-            let corners: Vec<DVec3> = face.used().iter().map(|&i| self.points[i as usize]).collect();
+            let corners: Vec<DVec3> = face
+                .used()
+                .iter()
+                .map(|&i| self.points[i as usize])
+                .collect();
             if face.count == 4 {
                 builder.quad(&corners, &boundary);
             } else {
@@ -246,7 +254,11 @@ impl EdgeTable {
         }
         for (e, edge) in edges.iter_mut().enumerate() {
             let length = (mesh.points[edge.1 as usize] - mesh.points[edge.0 as usize]).length();
-            let target = if quad_edge[e] { max_edge } else { std::f64::consts::SQRT_2 * max_edge };
+            let target = if quad_edge[e] {
+                max_edge
+            } else {
+                std::f64::consts::SQRT_2 * max_edge
+            };
             let needed = (length / target).ceil().clamp(1.0, 1e6) as u32;
             edge.2 = needed.max(min_segments);
         }
@@ -276,13 +288,12 @@ impl EdgeTable {
             }
         }
         let mut class_count = vec![0u32; edges.len()];
-        for e in 0..edges.len() {
+        for (e, edge) in edges.iter().enumerate() {
             let r = find(&mut parent, e);
-            class_count[r] = class_count[r].max(edges[e].2);
+            class_count[r] = class_count[r].max(edge.2);
         }
-        for e in 0..edges.len() {
-            let r = find(&mut parent, e);
-            edges[e].2 = class_count[r];
+        for (e, edge) in edges.iter_mut().enumerate() {
+            edge.2 = class_count[find(&mut parent, e)];
         }
         EdgeTable { index, edges }
     }
@@ -331,7 +342,10 @@ impl FaceBuilder<'_> {
 
     fn patch(&mut self, corners: &[u32]) {
         let set = &mut self.out.set;
-        if set.add_patch(corners, self.emission, self.reflectance).is_ok() {
+        if set
+            .add_patch(corners, self.emission, self.reflectance)
+            .is_ok()
+        {
             self.out.patch_face.push(self.face);
             return;
         }
@@ -350,7 +364,10 @@ impl FaceBuilder<'_> {
         let (nu, nv) = (counts[0].max(counts[2]), counts[1].max(counts[3]));
         let at = |i: usize, j: usize| {
             let (s, t) = (i as f64 / nu as f64, j as f64 / nv as f64);
-            (1.0 - s) * (1.0 - t) * c[0] + s * (1.0 - t) * c[1] + s * t * c[2] + (1.0 - s) * t * c[3]
+            (1.0 - s) * (1.0 - t) * c[0]
+                + s * (1.0 - t) * c[1]
+                + s * t * c[2]
+                + (1.0 - s) * t * c[3]
         };
         let regular = counts[0] == counts[2] && counts[1] == counts[3];
         if regular {
@@ -411,7 +428,9 @@ impl FaceBuilder<'_> {
     fn triangle(&mut self, c: &[DVec3], boundary: &[Vec<u32>]) {
         let counts: Vec<usize> = boundary.iter().map(|b| b.len() - 1).collect();
         let m = counts[0].max(counts[1]).max(counts[2]);
-        let at = |i: usize, j: usize| c[0] + (c[1] - c[0]) * (i as f64 / m as f64) + (c[2] - c[0]) * (j as f64 / m as f64);
+        let at = |i: usize, j: usize| {
+            c[0] + (c[1] - c[0]) * (i as f64 / m as f64) + (c[2] - c[0]) * (j as f64 / m as f64)
+        };
         // Point (i, j) of the level-m barycentric grid; i along c0->c1, j along c0->c2.
         let row_start = |j: usize| j * (m + 1) - j * (j.saturating_sub(1)) / 2;
         if counts.iter().all(|&n| n == m) {
@@ -585,7 +604,10 @@ mod tests {
         // Outer boundaries: the two triangles' union and the two quads' union.
         let fan = 10.0 + 109f64.sqrt() + 5f64.sqrt() + 2f64.sqrt();
         let quads = 10.0 + 2.0 * 20f64.sqrt() + 6.0;
-        assert!((perimeter_length - fan - quads).abs() < 1e-9, "{perimeter_length}");
+        assert!(
+            (perimeter_length - fan - quads).abs() < 1e-9,
+            "{perimeter_length}"
+        );
         assert!(sub.set.patches.iter().all(|p| p.normal.z > 0.999));
         let longest = sub
             .set

@@ -14,19 +14,26 @@
 //! - [`shapes`]: meshed boxes and spheres for tests and benchmarks.
 
 pub mod contour;
+pub mod display;
+pub mod export;
 pub mod formfactor;
 pub mod hemicube;
+pub mod irradiance;
 pub mod matrix;
 pub mod mesh;
 pub mod patch;
 pub mod progressive;
 pub mod quadrature;
+pub mod render;
 pub mod report;
 pub mod scene;
 pub mod settings;
+pub mod shaft;
 pub mod shapes;
+pub mod solve;
 pub mod solver;
 pub mod visibility;
+pub mod world_visibility;
 
 pub use contour::point_polygon_factor;
 pub use formfactor::{Quadrature, RayCastSettings, RayCaster};

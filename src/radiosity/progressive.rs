@@ -21,7 +21,7 @@ use super::formfactor::RayCaster;
 use super::hemicube::HemiCube;
 use super::matrix::FormFactorMatrix;
 use super::patch::PatchSet;
-use super::visibility::Visibility;
+use super::visibility::{InShot, ShotCull, Visibility};
 
 #[derive(Debug, Error, PartialEq)]
 pub enum ProgressiveError {
@@ -223,6 +223,9 @@ pub fn solve_progressive<V: Visibility>(
         ShootingFactors::HemiCube(h) => Some(h.buffers()),
         _ => None,
     };
+    // Occluders that matter per group of receivers for the current shooter.
+    let mut shot_cull = ShotCull::default();
+    let cull = matches!(factors, ShootingFactors::RayCast(_)) && !vis.always_visible();
     let fraction = |state: &ProgressiveState| match settings.selection {
         ShooterSelection::TotalPower => state.unshot_fraction(),
         ShooterSelection::Band(b) => state.unshot_fraction_per_band()[b],
@@ -239,10 +242,17 @@ pub fn solve_progressive<V: Visibility>(
         {
             h.row(set, i, buffers, &mut hemicube_row);
         }
+        if cull {
+            vis.prepare_shot(set, i, &mut shot_cull);
+        }
+        let in_shot = InShot {
+            vis,
+            shot: &shot_cull,
+        };
         // Gathering coefficient F_ji of each receiver j for this shooter.
         let coefficient = |j: usize| -> f64 {
             match factors {
-                ShootingFactors::RayCast(r) => r.factor(set, j, i, vis),
+                ShootingFactors::RayCast(r) => r.factor(set, j, i, &in_shot),
                 ShootingFactors::HemiCube(_) => hemicube_row[j] * area_i / set.patches[j].area,
                 ShootingFactors::Matrix(m) => m.get(i, j) * area_i / set.patches[j].area,
             }
@@ -256,7 +266,10 @@ pub fn solve_progressive<V: Visibility>(
             .map(|(chunk, ((radiosity, unshot), irradiance))| {
                 let mut partial = ShotPartial::default();
                 let first = chunk * CHUNK;
-                let receivers = radiosity.iter_mut().zip(unshot.iter_mut()).zip(irradiance.iter_mut());
+                let receivers = radiosity
+                    .iter_mut()
+                    .zip(unshot.iter_mut())
+                    .zip(irradiance.iter_mut());
                 for (k, ((b, db), h)) in receivers.enumerate() {
                     let j = first + k;
                     let patch = &set.patches[j];

@@ -27,6 +27,9 @@ pub struct SurfaceTag {
     pub shape: u32,
 }
 
+/// No back-side patch.
+pub const NO_TWIN: u32 = u32::MAX;
+
 /// The meshed scene the radiosity solver works on.
 #[derive(Clone, Debug)]
 pub struct RadiosityScene {
@@ -34,6 +37,11 @@ pub struct RadiosityScene {
     pub patches: PatchSet,
     /// The input face of every patch.
     pub patch_face: Vec<u32>,
+    /// The patch on the other side of the same surface (two-sided lights, `twosided`),
+    /// or [`NO_TWIN`]. Back patches come after all front patches.
+    pub twin: Vec<u32>,
+    /// Number of front patches (the rest are back sides).
+    pub front_count: usize,
     /// The unsubdivided faces (the occluders for shadow rays).
     pub faces: FaceMesh,
     pub tags: Vec<SurfaceTag>,
@@ -50,7 +58,10 @@ impl RadiosityScene {
     }
 
     /// Meshes the diffuse surfaces of `desc` with the patch size of `settings`.
-    pub fn from_desc(desc: &SceneDesc, settings: &RadiositySettings) -> Result<RadiosityScene, SceneError> {
+    pub fn from_desc(
+        desc: &SceneDesc,
+        settings: &RadiositySettings,
+    ) -> Result<RadiosityScene, SceneError> {
         let mut warnings = Vec::new();
         let shapes = flatten(desc);
         let mut specular_at = None;
@@ -58,20 +69,25 @@ impl RadiosityScene {
         let mut shape_tags = Vec::with_capacity(shapes.len());
         for (k, (shape, _)) in shapes.iter().enumerate() {
             let Some(material) = desc.materials.get(shape.material as usize) else {
-                return Err(SceneError::at(&shape.loc, format!("material index {} out of range", shape.material)));
+                return Err(SceneError::at(
+                    &shape.loc,
+                    format!("material index {} out of range", shape.material),
+                ));
             };
             let reflectance = match material {
-                MaterialDesc::Diffuse { reflectance } => reflectance.to_array().map(|c| (c as f64).clamp(0.0, 1.0)),
+                MaterialDesc::Diffuse { reflectance } => {
+                    reflectance.to_array().map(|c| (c as f64).clamp(0.0, 1.0))
+                }
                 MaterialDesc::Interface => [0.0; 3],
                 MaterialDesc::Dielectric { .. } | MaterialDesc::Conductor(_) => {
                     specular_at.get_or_insert_with(|| shape.loc.clone());
                     [0.0; 3]
                 }
             };
-            let emission = shape
-                .area_light
-                .as_ref()
-                .map_or([0.0; 3], |a| a.l.to_array().map(|l| std::f64::consts::PI * l.max(0.0) as f64));
+            let emission = shape.area_light.as_ref().map_or([0.0; 3], |a| {
+                a.l.to_array()
+                    .map(|l| std::f64::consts::PI * l.max(0.0) as f64)
+            });
             let is_interface = matches!(material, MaterialDesc::Interface);
             if is_interface && emission == [0.0; 3] {
                 shape_tags.push(None);
@@ -95,7 +111,9 @@ impl RadiosityScene {
             if let LightDesc::Infinite { loc, .. } = light {
                 warnings.push(Warning {
                     loc: loc.clone(),
-                    message: "radiosity: infinite (environment) lights are not supported and are ignored".into(),
+                    message:
+                        "radiosity: infinite (environment) lights are not supported and are ignored"
+                            .into(),
                 });
             }
         }
@@ -113,30 +131,45 @@ impl RadiosityScene {
         let max_edge = max_area.sqrt();
 
         let mut faces = FaceMesh::new();
-        for (((shape, xf), tag), _) in shapes.iter().zip(&shape_tags).zip(0..) {
+        for ((shape, xf), tag) in shapes.iter().zip(&shape_tags) {
             let Some(tag) = *tag else { continue };
-            let first_face = faces.faces.len();
             add_shape(&mut faces, shape, xf, tag, max_edge, &mut warnings)?;
-            let t = &tags[tag as usize];
-            let two_sided_light = shape.area_light.as_ref().is_some_and(|a| a.two_sided);
-            let back_patch = two_sided_light || (settings.two_sided && t.emission == [0.0; 3]);
-            if back_patch {
-                let front: Vec<_> = faces.faces[first_face..].to_vec();
-                for f in front {
-                    let mut c: Vec<u32> = f.corners[..f.count as usize].to_vec();
-                    c.reverse();
-                    faces.add_face(&c, f.tag);
-                }
-            }
         }
         let Subdivision {
-            set,
-            patch_face,
+            mut set,
+            mut patch_face,
             dropped,
         } = faces.subdivide(max_edge, settings.subdivision, |tag| {
             let t = &tags[tag as usize];
             (t.emission, t.reflectance)
         });
+        // Back sides: the same points in reverse order, so both sides share vertices
+        // and every back patch knows its front twin.
+        let front_count = set.len();
+        let mut twin = vec![NO_TWIN; front_count];
+        for i in 0..front_count {
+            let tag = faces.faces[patch_face[i] as usize].tag;
+            let t = &tags[tag as usize];
+            let two_sided_light = shapes[t.shape as usize]
+                .0
+                .area_light
+                .as_ref()
+                .is_some_and(|a| a.two_sided);
+            if !(two_sided_light
+                || settings.two_sided && t.emission == [0.0; 3] && t.reflectance != [0.0; 3])
+            {
+                continue;
+            }
+            let p = &set.patches[i];
+            let mut corners: Vec<u32> = p.corners[..p.corner_count as usize].to_vec();
+            corners.reverse();
+            let (emission, reflectance) = (p.emission, p.reflectance);
+            if set.add_patch(&corners, emission, reflectance).is_ok() {
+                twin[i] = set.len() as u32 - 1;
+                twin.push(i as u32);
+                patch_face.push(patch_face[i]);
+            }
+        }
         if dropped > 0 {
             warnings.push(Warning {
                 loc: desc.camera.loc.clone(),
@@ -146,6 +179,8 @@ impl RadiosityScene {
         Ok(RadiosityScene {
             patches: set,
             patch_face,
+            twin,
+            front_count,
             faces,
             tags,
             max_edge,
@@ -163,7 +198,9 @@ fn flatten(desc: &SceneDesc) -> Vec<(ShapeDesc, DMat4)> {
         .map(|s| (s.clone(), s.render_from_object.m.as_dmat4()))
         .collect();
     for inst in &desc.instances {
-        let Some(object) = desc.objects.get(inst.object) else { continue };
+        let Some(object) = desc.objects.get(inst.object) else {
+            continue;
+        };
         let to_render = inst.render_from_instance.m.as_dmat4();
         for s in &object.shapes {
             let mut s = s.clone();
@@ -184,18 +221,25 @@ fn scale_of(xf: &DMat4) -> f64 {
 fn shape_area(shape: &ShapeDesc, xf: &DMat4) -> f64 {
     let s2 = scale_of(xf).powi(2);
     match &shape.geometry {
-        Geometry::TriangleMesh { positions, indices, .. } => indices
+        Geometry::TriangleMesh {
+            positions, indices, ..
+        } => indices
             .chunks_exact(3)
             .map(|t| {
-                let p = [t[0], t[1], t[2]].map(|i| xf.transform_point3(positions[i as usize].as_dvec3()));
+                let p = [t[0], t[1], t[2]]
+                    .map(|i| xf.transform_point3(positions[i as usize].as_dvec3()));
                 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length()
             })
             .sum(),
-        Geometry::BilinearMesh { positions, indices, .. } => indices
+        Geometry::BilinearMesh {
+            positions, indices, ..
+        } => indices
             .chunks_exact(4)
             .map(|q| {
-                let p = [q[0], q[1], q[3], q[2]].map(|i| xf.transform_point3(positions[i as usize].as_dvec3()));
-                0.5 * ((p[1] - p[0]).cross(p[2] - p[0]).length() + (p[2] - p[0]).cross(p[3] - p[0]).length())
+                let p = [q[0], q[1], q[3], q[2]]
+                    .map(|i| xf.transform_point3(positions[i as usize].as_dvec3()));
+                0.5 * ((p[1] - p[0]).cross(p[2] - p[0]).length()
+                    + (p[2] - p[0]).cross(p[3] - p[0]).length())
             })
             .sum(),
         Geometry::Sphere {
@@ -205,7 +249,12 @@ fn shape_area(shape: &ShapeDesc, xf: &DMat4) -> f64 {
             phi_max_deg,
         } => {
             let (zl, zh) = sphere_z_range(*radius, *z_min, *z_max);
-            (*phi_max_deg as f64).to_radians().clamp(0.0, std::f64::consts::TAU) * *radius as f64 * (zh - zl) * s2
+            (*phi_max_deg as f64)
+                .to_radians()
+                .clamp(0.0, std::f64::consts::TAU)
+                * *radius as f64
+                * (zh - zl)
+                * s2
         }
         Geometry::Disk {
             radius,
@@ -213,7 +262,9 @@ fn shape_area(shape: &ShapeDesc, xf: &DMat4) -> f64 {
             phi_max_deg,
             ..
         } => {
-            let phi = (*phi_max_deg as f64).to_radians().clamp(0.0, std::f64::consts::TAU);
+            let phi = (*phi_max_deg as f64)
+                .to_radians()
+                .clamp(0.0, std::f64::consts::TAU);
             0.5 * phi * ((*radius as f64).powi(2) - (*inner_radius as f64).powi(2)).max(0.0) * s2
         }
     }
@@ -268,16 +319,28 @@ fn add_shape(
                     None => flip,
                 };
                 let tri = v.map(|i| index[i]);
-                triangles.push(if reverse { [tri[0], tri[2], tri[1]] } else { tri });
+                triangles.push(if reverse {
+                    [tri[0], tri[2], tri[1]]
+                } else {
+                    tri
+                });
             }
             faces.add_triangles_merging(&triangles, tag);
         }
-        Geometry::BilinearMesh { positions, indices, .. } => {
-            let index: Vec<u32> = positions.iter().map(|&v| faces.point(to_render(v))).collect();
+        Geometry::BilinearMesh {
+            positions, indices, ..
+        } => {
+            let index: Vec<u32> = positions
+                .iter()
+                .map(|&v| faces.point(to_render(v)))
+                .collect();
             let mut curved = 0usize;
             for q in indices.chunks_exact(4) {
                 if q.iter().any(|&i| i as usize >= index.len()) {
-                    return Err(SceneError::at(&shape.loc, "bilinear patch index out of range"));
+                    return Err(SceneError::at(
+                        &shape.loc,
+                        "bilinear patch index out of range",
+                    ));
                 }
                 // (p00, p10, p01, p11) around the boundary: p00, p10, p11, p01.
                 let mut c = [q[0], q[1], q[3], q[2]].map(|i| index[i as usize]);
@@ -305,10 +368,16 @@ fn add_shape(
         } => {
             let r = radius.abs() as f64;
             let (zl, zh) = sphere_z_range(*radius, *z_min, *z_max);
-            let (theta_top, theta_bottom) = ((zh / r).clamp(-1.0, 1.0).acos(), (zl / r).clamp(-1.0, 1.0).acos());
-            let phi_max = (*phi_max_deg as f64).to_radians().clamp(1e-6, std::f64::consts::TAU);
+            let (theta_top, theta_bottom) = (
+                (zh / r).clamp(-1.0, 1.0).acos(),
+                (zl / r).clamp(-1.0, 1.0).acos(),
+            );
+            let phi_max = (*phi_max_deg as f64)
+                .to_radians()
+                .clamp(1e-6, std::f64::consts::TAU);
             let local_edge = max_edge / scale_of(xf);
-            let rings = ((r * (theta_bottom - theta_top) / local_edge).ceil() as usize).clamp(2, 4096);
+            let rings =
+                ((r * (theta_bottom - theta_top) / local_edge).ceil() as usize).clamp(2, 4096);
             let segments = ((r * phi_max / local_edge).ceil() as usize).clamp(3, 8192);
             let point = |ring: usize, seg: usize| {
                 let theta = theta_top + (theta_bottom - theta_top) * ring as f64 / rings as f64;
@@ -322,7 +391,7 @@ fn add_shape(
                 xf.transform_point3(local)
             };
             let full = phi_max >= std::f64::consts::TAU - 1e-9;
-            add_grid(faces, rings, segments, full, flip, tag, |ring, seg| point(ring, seg), true);
+            add_grid(faces, rings, segments, full, flip, tag, point, true);
         }
         Geometry::Disk {
             height,
@@ -334,7 +403,9 @@ fn add_shape(
             if ro <= ri {
                 return Ok(());
             }
-            let phi_max = (*phi_max_deg as f64).to_radians().clamp(1e-6, std::f64::consts::TAU);
+            let phi_max = (*phi_max_deg as f64)
+                .to_radians()
+                .clamp(1e-6, std::f64::consts::TAU);
             let local_edge = max_edge / scale_of(xf);
             let rings = (((ro - ri) / local_edge).ceil() as usize).clamp(1, 4096);
             let segments = ((ro * phi_max / local_edge).ceil() as usize).clamp(3, 8192);
@@ -344,7 +415,7 @@ fn add_shape(
                 xf.transform_point3(DVec3::new(rho * phi.cos(), rho * phi.sin(), *height as f64))
             };
             let full = phi_max >= std::f64::consts::TAU - 1e-9;
-            add_grid(faces, rings, segments, full, flip, tag, |ring, seg| point(ring, seg), false);
+            add_grid(faces, rings, segments, full, flip, tag, point, false);
         }
     }
     Ok(())
@@ -378,9 +449,19 @@ fn add_grid(
     for ring in 0..rings {
         for seg in 0..segments {
             let mut c = if rings_run_down {
-                [at(ring + 1, seg), at(ring + 1, seg + 1), at(ring, seg + 1), at(ring, seg)]
+                [
+                    at(ring + 1, seg),
+                    at(ring + 1, seg + 1),
+                    at(ring, seg + 1),
+                    at(ring, seg),
+                ]
             } else {
-                [at(ring, seg), at(ring + 1, seg), at(ring + 1, seg + 1), at(ring, seg + 1)]
+                [
+                    at(ring, seg),
+                    at(ring + 1, seg),
+                    at(ring + 1, seg + 1),
+                    at(ring, seg + 1),
+                ]
             };
             if flip {
                 c.reverse();
@@ -413,7 +494,10 @@ mod tests {
         // from the scene's quads (two triangles each): their sum, to rounding.
         let mut expected = 0.0;
         for s in &desc.shapes {
-            if let Geometry::TriangleMesh { positions, indices, .. } = &s.geometry {
+            if let Geometry::TriangleMesh {
+                positions, indices, ..
+            } = &s.geometry
+            {
                 for t in indices.chunks_exact(3) {
                     let p = [t[0], t[1], t[2]].map(|i| positions[i as usize].as_dvec3());
                     expected += 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
@@ -425,13 +509,21 @@ mod tests {
         // Every planar quad of the scene merged back (the red wall is not planar).
         let triangles = scene.faces.faces.iter().filter(|f| f.count == 3).count();
         assert_eq!(triangles, 2);
-        assert!(scene.patches.len() > 900 && scene.patches.len() < 1400, "{}", scene.patches.len());
+        assert!(
+            scene.patches.len() > 900 && scene.patches.len() < 1400,
+            "{}",
+            scene.patches.len()
+        );
         // Light patches emit pi L on their front, which faces down.
         let light: Vec<usize> = (0..scene.patches.len())
             .filter(|&i| scene.patches.patches[i].emission[0] > 0.0)
             .collect();
         let light_area: f64 = light.iter().map(|&i| scene.patches.patches[i].area).sum();
         assert!((light_area - 13650.0).abs() < 1e-6);
-        assert!(light.iter().all(|&i| scene.patches.patches[i].normal.y < -0.999));
+        assert!(
+            light
+                .iter()
+                .all(|&i| scene.patches.patches[i].normal.y < -0.999)
+        );
     }
 }

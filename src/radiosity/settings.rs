@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! Integrator "radiosity"
-//!     "float maxpatcharea" [400]        # scene units^2 (mm^2 for the Cornell box)
+//!     "float maxpatcharea" [600]        # scene units^2 (default: total area / 2000)
 //!     "integer subdivision" [1]         # split every input edge into at least this many
 //!     "string formfactor" "raycast"     # or "hemicube"
 //!     "integer hemicuberes" [128]
@@ -50,7 +50,8 @@ pub enum VisibilitySource {
 #[derive(Clone, Debug, PartialEq)]
 pub struct RadiositySettings {
     /// Largest patch area in scene units squared; `None` picks the total diffuse
-    /// area / [`DEFAULT_PATCH_COUNT`].
+    /// area / [`DEFAULT_PATCH_COUNT`] (which gives somewhat more patches, as edges
+    /// are split into whole numbers of segments).
     pub max_patch_area: Option<f64>,
     /// Every input edge is split into at least this many segments.
     pub subdivision: u32,
@@ -71,7 +72,7 @@ pub struct RadiositySettings {
 }
 
 /// Patches aimed at when no `maxpatcharea` is given.
-pub const DEFAULT_PATCH_COUNT: f64 = 4000.0;
+pub const DEFAULT_PATCH_COUNT: f64 = 2000.0;
 
 impl Default for RadiositySettings {
     fn default() -> Self {
@@ -97,10 +98,14 @@ impl RadiositySettings {
         let defaults = RadiositySettings::default();
         let bad = |name: &str, message: String| {
             let loc = params.lookup(name).map_or(&desc.loc, |p| &p.loc).clone();
-            SceneError::at(&loc, format!("Integrator \"radiosity\": \"{name}\" {message}"))
+            SceneError::at(
+                &loc,
+                format!("Integrator \"radiosity\": \"{name}\" {message}"),
+            )
         };
-        // "float maxpatcharea" [total area / 4000]: largest patch area, scene units^2.
-        // Example: `"float maxpatcharea" [200]` gives about 10^4 patches in the Cornell box.
+        // "float maxpatcharea" [total diffuse area / 2000]: largest patch area, scene
+        // units^2. Example: `"float maxpatcharea" [230]` gives 10^4 patches in the
+        // Cornell box (mm).
         let max_patch_area = if params.has("maxpatcharea") {
             let a = params.finite_float("maxpatcharea", 0.0)?;
             if a <= 0.0 {
@@ -115,7 +120,10 @@ impl RadiositySettings {
         // Example: `"integer subdivision" [8]`.
         let subdivision = params.count("subdivision", defaults.subdivision)?;
         if subdivision == 0 || subdivision > 4096 {
-            return Err(bad("subdivision", format!("must lie in 1..=4096, got {subdivision}")));
+            return Err(bad(
+                "subdivision",
+                format!("must lie in 1..=4096, got {subdivision}"),
+            ));
         }
         // "string formfactor" ["raycast"]: "raycast" (exact contour factors with shadow
         // rays) or "hemicube". Example: `"string formfactor" "hemicube"`.
@@ -132,7 +140,10 @@ impl RadiositySettings {
         // "integer hemicuberes" [128]: cells across the hemi-cube's top face (even).
         // Example: `"integer hemicuberes" [256]`.
         let hemicube_resolution = params.count("hemicuberes", 128)? as usize;
-        if hemicube_resolution < 2 || hemicube_resolution % 2 != 0 || hemicube_resolution > 4096 {
+        if hemicube_resolution < 2
+            || !hemicube_resolution.is_multiple_of(2)
+            || hemicube_resolution > 4096
+        {
             return Err(bad(
                 "hemicuberes",
                 format!("must be even and in 2..=4096, got {hemicube_resolution}"),
@@ -148,7 +159,9 @@ impl RadiositySettings {
             other => {
                 return Err(bad(
                     "solver",
-                    format!("must be \"progressive\", \"gaussseidel\" or \"jacobi\", got \"{other}\""),
+                    format!(
+                        "must be \"progressive\", \"gaussseidel\" or \"jacobi\", got \"{other}\""
+                    ),
                 ));
             }
         };
@@ -157,11 +170,15 @@ impl RadiositySettings {
         // Example: `"float tolerance" [0.01]`.
         let tolerance = params.finite_float("tolerance", defaults.tolerance as f32)? as f64;
         if !(tolerance > 0.0 && tolerance < 1.0) {
-            return Err(bad("tolerance", format!("must lie in (0, 1), got {tolerance}")));
+            return Err(bad(
+                "tolerance",
+                format!("must lie in (0, 1), got {tolerance}"),
+            ));
         }
         // "integer maxiterations" [100000]: shots (progressive) or sweeps at most.
         // Example: `"integer maxiterations" [5000]`.
-        let max_iterations = params.count("maxiterations", defaults.max_iterations as u32)? as usize;
+        let max_iterations =
+            params.count("maxiterations", defaults.max_iterations as u32)? as usize;
         if max_iterations == 0 {
             return Err(bad("maxiterations", "must be at least 1".into()));
         }

@@ -4,6 +4,7 @@
 use glam::DVec3;
 
 use super::patch::PatchSet;
+pub use super::shaft::ShotCull;
 
 /// Answers whether the open segment between two points on two patches is unobstructed.
 pub trait Visibility: Sync {
@@ -15,6 +16,41 @@ pub trait Visibility: Sync {
     /// deliberate no-occlusion run), so callers may skip shadow rays altogether.
     fn always_visible(&self) -> bool {
         false
+    }
+
+    /// Optional speed-up for the many queries of one progressive shot (rays between
+    /// patch `source` and every receiver): prepares `shot` (e.g. the occluders that can
+    /// matter per group of receivers). The default prepares nothing.
+    fn prepare_shot(&self, _set: &PatchSet, _source: usize, _shot: &mut ShotCull) {}
+
+    /// [`Visibility::visible`] for a query of the shot `shot` was prepared for.
+    fn visible_in_shot(
+        &self,
+        _shot: &ShotCull,
+        from: DVec3,
+        to: DVec3,
+        from_patch: usize,
+        to_patch: usize,
+    ) -> bool {
+        self.visible(from, to, from_patch, to_patch)
+    }
+}
+
+/// A visibility restricted to the queries of one prepared shot.
+pub struct InShot<'a, V: Visibility> {
+    pub vis: &'a V,
+    pub shot: &'a ShotCull,
+}
+
+impl<V: Visibility> Visibility for InShot<'_, V> {
+    #[inline]
+    fn visible(&self, from: DVec3, to: DVec3, from_patch: usize, to_patch: usize) -> bool {
+        self.vis
+            .visible_in_shot(self.shot, from, to, from_patch, to_patch)
+    }
+
+    fn always_visible(&self) -> bool {
+        self.vis.always_visible()
     }
 }
 

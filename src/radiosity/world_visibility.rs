@@ -9,7 +9,8 @@ use glam::{DVec3, Vec3};
 
 use super::patch::PatchSet;
 use super::scene::RadiosityScene;
-use super::visibility::Visibility;
+use super::shaft::ShaftCuller;
+use super::visibility::{ShotCull, Visibility};
 use crate::render::accel::TriangleBvh;
 use crate::render::geometry::Ray;
 use crate::render::geometry::ray::offset_origin;
@@ -71,26 +72,110 @@ impl Visibility for WorldVisibility<'_> {
 /// Occlusion by the faces the patches were cut from (quads as two triangles), in the
 /// renderer's fast triangle BVH: the same surfaces the solver sees, with far fewer
 /// triangles than patches.
+///
+/// Faces that cannot block anything are left out: a segment between two points of
+/// the scene crosses a face's plane only if its ends lie strictly on opposite sides,
+/// so a face with every vertex of the scene on one (closed) side of its plane, such as
+/// the walls of a room, never occludes. The walls of the Cornell box drop out and
+/// only the blocks and the light remain, which makes most shadow rays one box test.
 pub struct FaceVisibility {
     bvh: TriangleBvh,
-    normals: Vec<Vec3>,
+    /// Patch normals scaled by the offset that lifts ray ends off their surfaces.
+    lifts: Vec<Vec3>,
+    /// The length of the lifts.
+    lift: f64,
+    occluders: usize,
+    shafts: ShaftCuller,
 }
+
+/// Ray ends are lifted off their patches by this fraction of the scene's size: far
+/// above f32 rounding of the coordinates (1e-7 relative), far below any feature.
+const LIFT: f64 = 1e-6;
+
+/// Vertices closer to a plane than this fraction of the scene's size count as on it.
+const PLANE_TOLERANCE: f64 = 1e-7;
+
+/// Above this many face-vertex pairs, only the scene's bounding box is tested against
+/// each face plane (conservative: keeps more faces).
+const EXACT_CULL_LIMIT: usize = 50_000_000;
 
 impl FaceVisibility {
     pub fn new(scene: &RadiosityScene) -> FaceVisibility {
-        let vertices: Vec<Vec3> = scene.faces.points.iter().map(|p| p.as_vec3()).collect();
+        let points = &scene.faces.points;
+        let vertices: Vec<Vec3> = points.iter().map(|p| p.as_vec3()).collect();
+        let lower = points.iter().copied().fold(DVec3::INFINITY, DVec3::min);
+        let upper = points.iter().copied().fold(DVec3::NEG_INFINITY, DVec3::max);
+        let size = (upper - lower).length().max(f64::MIN_POSITIVE);
+        let box_corners: Vec<DVec3> = (0..8)
+            .map(|k| {
+                DVec3::new(
+                    if k & 1 == 0 { lower.x } else { upper.x },
+                    if k & 2 == 0 { lower.y } else { upper.y },
+                    if k & 4 == 0 { lower.z } else { upper.z },
+                )
+            })
+            .collect();
+        let exact = scene.faces.faces.len().saturating_mul(points.len()) <= EXACT_CULL_LIMIT;
+        let tested: &[DVec3] = if exact { points } else { &box_corners };
         let mut triangles = Vec::with_capacity(scene.faces.faces.len() * 2);
+        let can_block = |c: [u32; 3]| {
+            let [a, b, d] = c.map(|i| points[i as usize]);
+            let n = (b - a).cross(d - a);
+            let length = n.length();
+            if length == 0.0 {
+                return false;
+            }
+            let n = n / length;
+            let (mut front, mut back) = (false, false);
+            for p in tested {
+                let h = n.dot(*p - a);
+                front |= h > PLANE_TOLERANCE * size;
+                back |= h < -PLANE_TOLERANCE * size;
+                if front && back {
+                    return true;
+                }
+            }
+            false
+        };
         for f in &scene.faces.faces {
             let c = f.corners;
-            triangles.push([c[0], c[1], c[2]]);
-            if f.count == 4 {
-                triangles.push([c[0], c[2], c[3]]);
+            let halves: &[[u32; 3]] = if f.count == 4 {
+                &[[c[0], c[1], c[2]], [c[0], c[2], c[3]]]
+            } else {
+                &[[c[0], c[1], c[2]]]
+            };
+            for &t in halves {
+                if can_block(t) {
+                    triangles.push(t);
+                }
             }
         }
+        let corners: Vec<[DVec3; 3]> = triangles
+            .iter()
+            .map(|t| t.map(|i| points[i as usize]))
+            .collect();
+        let lift = (LIFT * size) as f32;
         FaceVisibility {
             bvh: TriangleBvh::build(&vertices, &triangles),
-            normals: patch_normals(&scene.patches),
+            lifts: patch_normals(&scene.patches)
+                .into_iter()
+                .map(|n| n * lift)
+                .collect(),
+            lift: lift as f64 * 1.001,
+            occluders: triangles.len(),
+            shafts: ShaftCuller::new(
+                &scene.patches,
+                &scene.patch_face,
+                &corners,
+                scene.max_edge,
+                PLANE_TOLERANCE * size,
+            ),
         }
+    }
+
+    /// Number of triangles that can block a shadow ray.
+    pub fn occluder_count(&self) -> usize {
+        self.occluders
     }
 
     /// Whether anything blocks `ray` before `t_max`.
@@ -100,14 +185,56 @@ impl FaceVisibility {
 }
 
 impl Visibility for FaceVisibility {
+    fn always_visible(&self) -> bool {
+        self.occluders == 0
+    }
+
+    fn prepare_shot(&self, set: &PatchSet, source: usize, shot: &mut ShotCull) {
+        // Receivers that exchange light with the shooter lie in front of it, so every
+        // ray of the shot ends at its centroid lifted along its normal.
+        let apex = set.patches[source].centroid + self.lifts[source].as_dvec3();
+        self.shafts.prepare(source, apex, self.lift, shot);
+    }
+
+    fn visible_in_shot(
+        &self,
+        shot: &ShotCull,
+        from: DVec3,
+        to: DVec3,
+        from_patch: usize,
+        to_patch: usize,
+    ) -> bool {
+        if from_patch >= self.lifts.len() || to_patch >= self.lifts.len() {
+            return self.visible(from, to, from_patch, to_patch);
+        }
+        let d = to - from;
+        let lift = |patch: usize, towards: DVec3| {
+            let l = self.lifts[patch].as_dvec3();
+            if l.dot(towards) < 0.0 { -l } else { l }
+        };
+        let o = from + lift(from_patch, d);
+        let target = to + lift(to_patch, -d);
+        if !shot.prepared_for(to_patch, target) {
+            return self.visible(from, to, from_patch, to_patch);
+        }
+
+        !self.shafts.blocked(shot, from_patch, o, FAR_END as f64)
+    }
+
     fn visible(&self, from: DVec3, to: DVec3, from_patch: usize, to_patch: usize) -> bool {
-        let ray = offset_segment(
-            from.as_vec3(),
-            normal_of(&self.normals, from_patch),
-            to.as_vec3(),
-            normal_of(&self.normals, to_patch),
-        );
-        !self.bvh.occluded(&ray, 1.0 - FAR_END)
+        if self.occluders == 0 {
+            return true;
+        }
+        // Lift each end along its patch normal, towards the side the other end is on.
+        let (p0, p1) = (from.as_vec3(), to.as_vec3());
+        let d = p1 - p0;
+        let lift = |patch: usize, towards: Vec3| {
+            let l = normal_of(&self.lifts, patch);
+            if l.dot(towards) < 0.0 { -l } else { l }
+        };
+        let o = p0 + lift(from_patch, d);
+        let target = p1 + lift(to_patch, -d);
+        !self.bvh.occluded(&Ray::new(o, target - o), 1.0 - FAR_END)
     }
 }
 

@@ -23,6 +23,8 @@ use crate::image::Image;
 use crate::image::film::{Film, FilmPixel, NonFinite};
 use crate::image::filter::Filter;
 use crate::math::hash::hash_u64s;
+use crate::radiosity::render::Shading;
+use crate::radiosity::scene::RadiosityScene;
 use crate::scene::{SamplerKind, SceneDesc, SceneError, Warning};
 
 /// Command-line overrides of the scene's settings.
@@ -64,6 +66,8 @@ pub struct Session {
     pub imaging_ratio: f32,
     /// Warnings from preparing the session (the parser's are in the scene).
     pub warnings: Vec<Warning>,
+    /// The meshed scene, when the integrator is radiosity.
+    pub radiosity: Option<Box<RadiosityScene>>,
 }
 
 /// A finished (or interrupted) render.
@@ -82,6 +86,8 @@ pub struct RenderOutput {
 enum PixelIntegrator<'a> {
     Path(&'a PathSettings),
     PhotonMap { ctx: EyeContext<'a>, seed: u64 },
+    /// A solved radiosity scene seen from the camera.
+    Radiosity(&'a Shading<'a>),
 }
 
 /// Names the gather-ray streams of the photon mapper.
@@ -102,6 +108,14 @@ impl Session {
         let (world, w) = World::build(desc)?;
         warnings.extend(w);
         let camera = super::camera::from_desc(&desc.camera, &desc.film, resolution, &mut warnings)?;
+        let radiosity = match &integrator {
+            Integrator::Radiosity(settings) => {
+                let scene = RadiosityScene::from_desc(desc, settings)?;
+                warnings.extend(scene.warnings.iter().cloned());
+                Some(Box::new(scene))
+            }
+            _ => None,
+        };
         let filter = match desc.filter.kind {
             crate::scene::FilterKind::Box => Filter::box_filter(desc.filter.radius),
             crate::scene::FilterKind::Triangle => Filter::triangle(desc.filter.radius),
@@ -120,6 +134,7 @@ impl Session {
             sampler: desc.sampler.kind,
             imaging_ratio: desc.film.iso / 100.0,
             warnings,
+            radiosity,
         })
     }
 
@@ -164,6 +179,13 @@ impl Session {
                 out.seconds = start.elapsed().as_secs_f64();
                 out
             }
+            Integrator::Radiosity(settings) => {
+                let scene = self
+                    .radiosity
+                    .as_deref()
+                    .expect("Session::new meshes the scene for radiosity");
+                crate::radiosity::render::render_session(self, scene, settings, progress, snapshot)
+            }
             Integrator::Sppm(settings) => {
                 let out = sppm::render(self, settings, progress, snapshot);
                 let mut film = Film::new(out.image.width, out.image.height);
@@ -184,6 +206,17 @@ impl Session {
                 }
             }
         }
+    }
+
+    /// The pass loop over a solved radiosity scene's shading (the radiosity integrator,
+    /// and the images of `radiant radiosity`).
+    pub fn render_shading(
+        &self,
+        shading: &Shading<'_>,
+        progress: &Progress,
+        snapshot: &mut dyn FnMut(u32, &Image),
+    ) -> RenderOutput {
+        self.render_passes(&PixelIntegrator::Radiosity(shading), progress, snapshot)
     }
 
     /// The pass loop of the per-pixel integrators.
@@ -246,7 +279,7 @@ impl Session {
                 let mut rays = 0u64;
                 let mut scratch = match pixel {
                     PixelIntegrator::PhotonMap { ctx, .. } => Some(EyeScratch::new(ctx.maps)),
-                    PixelIntegrator::Path(_) => None,
+                    PixelIntegrator::Path(_) | PixelIntegrator::Radiosity(_) => None,
                 };
                 for (x, film_pixel) in row.iter_mut().enumerate() {
                     for index in first..first + count {
@@ -294,6 +327,7 @@ impl Session {
         };
         let (l, rays) = match (pixel, scratch) {
             (PixelIntegrator::Path(s), _) => path::radiance(&self.world, s, cr.ray, &mut sampler),
+            (PixelIntegrator::Radiosity(shading), _) => shading.radiance(cr.ray, &mut sampler),
             (PixelIntegrator::PhotonMap { ctx, seed }, Some(scratch)) => {
                 let gather = GatherStream {
                     kind: self.sampler,

@@ -3,7 +3,10 @@
 
 mod common;
 mod computed;
+mod cornell_radiance;
 mod enclosures;
+mod export;
 mod formfactors;
 mod hemicube;
 mod meshes;
+mod pipeline;

@@ -3,6 +3,7 @@
 mod bench_cmd;
 mod compare_cmd;
 mod lens_cmd;
+mod radiosity_cmd;
 mod render_cmd;
 
 use clap::{Parser, Subcommand};
@@ -28,6 +29,9 @@ enum Command {
     Bench(bench_cmd::BenchArgs),
     /// Inspect a realistic-camera lens file: paraxial data, focus, field of view, exit pupil.
     Lens(lens_cmd::LensArgs),
+    /// Solve diffuse interreflection on a patch mesh (radiosity): energy balance, lit
+    /// mesh export (glTF, PLY), patch table, image or progressive image sequence.
+    Radiosity(radiosity_cmd::RadiosityArgs),
 }
 
 fn main() {
@@ -37,6 +41,7 @@ fn main() {
         Command::Compare(args) => compare_cmd::run(args),
         Command::Lens(args) => lens_cmd::run(args),
         Command::Bench(args) => bench_cmd::run(args),
+        Command::Radiosity(args) => radiosity_cmd::run(args),
     };
     if let Err(e) = result {
         eprintln!("radiant: {e:#}");

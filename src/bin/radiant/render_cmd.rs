@@ -50,7 +50,7 @@ pub struct RenderArgs {
     pub quiet: bool,
 }
 
-fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WIDTHxHEIGHT, got \"{s}\""))?;
@@ -208,7 +208,7 @@ fn snapshot_path(output: &Path, n: u32) -> PathBuf {
     output.with_file_name(name)
 }
 
-fn draw_progress(progress: &Progress, done: &std::sync::atomic::AtomicBool) {
+pub fn draw_progress(progress: &Progress, done: &std::sync::atomic::AtomicBool) {
     let bar = indicatif::ProgressBar::new(progress.total.load(Ordering::Relaxed).max(1));
     bar.set_style(
         indicatif::ProgressStyle::with_template(

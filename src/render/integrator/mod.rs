@@ -12,6 +12,8 @@ pub use path::PathSettings;
 pub use photon::{PhotonMapStats, PhotonSettings, Visualize};
 pub use sppm::{SppmSettings, SppmStats};
 
+use crate::radiosity::settings::RadiositySettings;
+use crate::radiosity::solve::RadiosityStats;
 use crate::scene::{IntegratorDesc, SceneError, Warning};
 
 /// The integrators radiant implements, with their settings.
@@ -23,6 +25,8 @@ pub enum Integrator {
     PhotonMap(PhotonSettings),
     /// Stochastic progressive photon mapping.
     Sppm(SppmSettings),
+    /// Finite-element diffuse transport on a patch mesh (`crate::radiosity`).
+    Radiosity(RadiositySettings),
 }
 
 /// What an integrator reports beyond the image (photon counts, radii, timings).
@@ -32,6 +36,7 @@ pub enum IntegratorStats {
     None,
     PhotonMap(PhotonMapStats),
     Sppm(SppmStats),
+    Radiosity(RadiosityStats),
 }
 
 impl std::fmt::Display for IntegratorStats {
@@ -41,12 +46,13 @@ impl std::fmt::Display for IntegratorStats {
             IntegratorStats::None => Ok(()),
             IntegratorStats::PhotonMap(s) => s.fmt(f),
             IntegratorStats::Sppm(s) => s.fmt(f),
+            IntegratorStats::Radiosity(s) => s.fmt(f),
         }
     }
 }
 
 /// Names accepted by `Integrator` and `--integrator`.
-pub const INTEGRATOR_NAMES: [&str; 4] = ["path", "photonmap", "photonviz", "sppm"];
+pub const INTEGRATOR_NAMES: [&str; 5] = ["path", "photonmap", "photonviz", "sppm", "radiosity"];
 
 impl Integrator {
     /// Chooses the integrator from a scene's `Integrator` directive. Names radiant does
@@ -61,6 +67,7 @@ impl Integrator {
                 Integrator::PhotonMap(PhotonSettings::from_desc(desc, Visualize::Density)?)
             }
             "sppm" => Integrator::Sppm(SppmSettings::from_desc(desc)?),
+            "radiosity" => Integrator::Radiosity(RadiositySettings::from_desc(desc)?),
             "volpath" => {
                 warnings.push(Warning {
                     loc: desc.loc.clone(),
@@ -91,6 +98,7 @@ impl Integrator {
             Integrator::PhotonMap(s) if s.visualize != Visualize::None => "photonviz",
             Integrator::PhotonMap(_) => "photonmap",
             Integrator::Sppm(_) => "sppm",
+            Integrator::Radiosity(_) => "radiosity",
         }
     }
 }
