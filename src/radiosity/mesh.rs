@@ -12,7 +12,9 @@
 //! Forward Differencing", Graphics Hardware 2001).
 //!
 //! Triangle pairs of one surface that form a planar convex quad (a quad exported as two
-//! triangles) are merged back first, so they subdivide into quads.
+//! triangles) are merged back first, so they subdivide into quads. A curved bilinear
+//! patch is a quad face too: its grid points are bilinear in the corners, so they lie on
+//! the patch, and its cells (not planar) become two triangles each.
 
 use std::collections::HashMap;
 
@@ -36,6 +38,9 @@ pub struct Face {
     pub count: u8,
     /// The caller's surface tag (material, emission, shape), copied to every patch.
     pub tag: u32,
+    /// A quad that is not planar: a bilinear patch, subdivided on its curved surface
+    /// (grid points bilinear in the corners, cells split into triangles).
+    pub curved: bool,
 }
 
 impl Face {
@@ -104,7 +109,22 @@ impl FaceMesh {
             corners: c,
             count: count as u8,
             tag,
+            curved: false,
         });
+    }
+
+    /// Adds the bilinear patch with boundary `corners` (p00, p10, p11, p01): planar and
+    /// convex ones as quads, the others as curved faces.
+    pub fn add_bilinear(&mut self, corners: [u32; 4], tag: u32) {
+        if self.is_planar_convex(&corners) {
+            self.add_face(&corners, tag);
+            return;
+        }
+        let before = self.faces.len();
+        self.add_face(&corners, tag);
+        if let Some(face) = self.faces.get_mut(before) {
+            face.curved = true;
+        }
     }
 
     /// Adds the triangles of one surface, merging pairs that share an edge (with
@@ -163,7 +183,8 @@ impl FaceMesh {
         }
     }
 
-    fn is_planar_convex(&self, quad: &[u32; 4]) -> bool {
+    /// Whether the quad is planar (within half the patch set's tolerance) and convex.
+    pub fn is_planar_convex(&self, quad: &[u32; 4]) -> bool {
         let p = quad.map(|i| self.points[i as usize]);
         let Ok(shape) = polygon_shape(&p) else {
             return false;

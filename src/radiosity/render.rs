@@ -258,7 +258,7 @@ pub fn scene_visibility<'a>(
     settings: &RadiositySettings,
 ) -> SceneVisibility<'a> {
     match settings.visibility {
-        VisibilitySource::Patches => SceneVisibility::Faces(FaceVisibility::new(scene)),
+        VisibilitySource::Patches => SceneVisibility::Faces(Box::new(FaceVisibility::new(scene))),
         VisibilitySource::World => {
             SceneVisibility::World(WorldVisibility::new(world, &scene.patches))
         }

@@ -347,16 +347,17 @@ fn add_shape(
                 if flip {
                     c.reverse();
                 }
-                let before = faces.faces.len();
-                faces.add_triangles_merging(&[[c[0], c[1], c[2]], [c[0], c[2], c[3]]], tag);
-                if faces.faces.len() - before == 2 {
+                if !faces.is_planar_convex(&c) {
                     curved += 1;
                 }
+                faces.add_bilinear(c, tag);
             }
             if curved > 0 {
                 warnings.push(Warning {
                     loc: shape.loc.clone(),
-                    message: format!("radiosity: {curved} non-planar bilinear patch(es) meshed as two triangles each"),
+                    message: format!(
+                        "radiosity: {curved} curved bilinear patch(es) meshed on their surface, in triangles"
+                    ),
                 });
             }
         }

@@ -103,7 +103,11 @@ impl std::fmt::Display for RadiosityStats {
             "radiosity: {} patches, {} iterations ({}), solved in {:.2} s",
             self.patches,
             self.iterations,
-            if self.converged { "converged" } else { "not converged" },
+            if self.converged {
+                "converged"
+            } else {
+                "not converged"
+            },
             self.solve_seconds
         )?;
         writeln!(f, "radiosity: {}", self.balance.summary())

@@ -102,7 +102,6 @@ const EXACT_CULL_LIMIT: usize = 50_000_000;
 impl FaceVisibility {
     pub fn new(scene: &RadiosityScene) -> FaceVisibility {
         let points = &scene.faces.points;
-        let vertices: Vec<Vec3> = points.iter().map(|p| p.as_vec3()).collect();
         let lower = points.iter().copied().fold(DVec3::INFINITY, DVec3::min);
         let upper = points.iter().copied().fold(DVec3::NEG_INFINITY, DVec3::max);
         let size = (upper - lower).length().max(f64::MIN_POSITIVE);
@@ -117,9 +116,8 @@ impl FaceVisibility {
             .collect();
         let exact = scene.faces.faces.len().saturating_mul(points.len()) <= EXACT_CULL_LIMIT;
         let tested: &[DVec3] = if exact { points } else { &box_corners };
-        let mut triangles = Vec::with_capacity(scene.faces.faces.len() * 2);
-        let can_block = |c: [u32; 3]| {
-            let [a, b, d] = c.map(|i| points[i as usize]);
+        let mut triangles: Vec<[DVec3; 3]> = Vec::with_capacity(scene.faces.faces.len() * 2);
+        let can_block = |[a, b, d]: [DVec3; 3]| {
             let n = (b - a).cross(d - a);
             let length = n.length();
             if length == 0.0 {
@@ -137,7 +135,7 @@ impl FaceVisibility {
             }
             false
         };
-        for f in &scene.faces.faces {
+        for f in scene.faces.faces.iter().filter(|f| !f.curved) {
             let c = f.corners;
             let halves: &[[u32; 3]] = if f.count == 4 {
                 &[[c[0], c[1], c[2]], [c[0], c[2], c[3]]]
@@ -145,18 +143,35 @@ impl FaceVisibility {
                 &[[c[0], c[1], c[2]]]
             };
             for &t in halves {
-                if can_block(t) {
-                    triangles.push(t);
+                let corners = t.map(|i| points[i as usize]);
+                if can_block(corners) {
+                    triangles.push(corners);
                 }
             }
         }
-        let corners: Vec<[DVec3; 3]> = triangles
-            .iter()
-            .map(|t| t.map(|i| points[i as usize]))
-            .collect();
+        // Curved faces occlude with the surface their patches lie on.
+        let set = &scene.patches;
+        for (i, p) in set.patches.iter().enumerate().take(scene.front_count) {
+            if !scene.faces.faces[scene.patch_face[i] as usize].curved {
+                continue;
+            }
+            let c = p.corners;
+            let halves: &[[u32; 3]] = if p.corner_count == 4 {
+                &[[c[0], c[1], c[2]], [c[0], c[2], c[3]]]
+            } else {
+                &[[c[0], c[1], c[2]]]
+            };
+            for &t in halves {
+                let corners = t.map(|k| set.points[k as usize]);
+                if can_block(corners) {
+                    triangles.push(corners);
+                }
+            }
+        }
+        let soup: Vec<[Vec3; 3]> = triangles.iter().map(|t| t.map(|p| p.as_vec3())).collect();
         let lift = (LIFT * size) as f32;
         FaceVisibility {
-            bvh: TriangleBvh::build(&vertices, &triangles),
+            bvh: TriangleBvh::from_soup(&soup),
             lifts: patch_normals(&scene.patches)
                 .into_iter()
                 .map(|n| n * lift)
@@ -166,7 +181,7 @@ impl FaceVisibility {
             shafts: ShaftCuller::new(
                 &scene.patches,
                 &scene.patch_face,
-                &corners,
+                &triangles,
                 scene.max_edge,
                 PLANE_TOLERANCE * size,
             ),
@@ -240,7 +255,7 @@ impl Visibility for FaceVisibility {
 
 /// Either source, chosen at run time by the integrator's `visibility` parameter.
 pub enum SceneVisibility<'a> {
-    Faces(FaceVisibility),
+    Faces(Box<FaceVisibility>),
     World(WorldVisibility<'a>),
 }
 
@@ -250,6 +265,35 @@ impl Visibility for SceneVisibility<'_> {
         match self {
             SceneVisibility::Faces(v) => v.visible(from, to, from_patch, to_patch),
             SceneVisibility::World(v) => v.visible(from, to, from_patch, to_patch),
+        }
+    }
+
+    fn always_visible(&self) -> bool {
+        match self {
+            SceneVisibility::Faces(v) => v.always_visible(),
+            SceneVisibility::World(v) => v.always_visible(),
+        }
+    }
+
+    fn prepare_shot(&self, set: &PatchSet, source: usize, shot: &mut ShotCull) {
+        match self {
+            SceneVisibility::Faces(v) => v.prepare_shot(set, source, shot),
+            SceneVisibility::World(v) => v.prepare_shot(set, source, shot),
+        }
+    }
+
+    #[inline]
+    fn visible_in_shot(
+        &self,
+        shot: &ShotCull,
+        from: DVec3,
+        to: DVec3,
+        from_patch: usize,
+        to_patch: usize,
+    ) -> bool {
+        match self {
+            SceneVisibility::Faces(v) => v.visible_in_shot(shot, from, to, from_patch, to_patch),
+            SceneVisibility::World(v) => v.visible_in_shot(shot, from, to, from_patch, to_patch),
         }
     }
 }
