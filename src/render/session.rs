@@ -82,11 +82,11 @@ pub struct RenderOutput {
     pub stats: IntegratorStats,
 }
 
-/// The per-pixel integrator of a render, with what it prepared (photon maps).
+/// The per-pixel integrator of a render, with what it prepared (photon maps, a solved
+/// radiosity scene).
 enum PixelIntegrator<'a> {
     Path(&'a PathSettings),
     PhotonMap { ctx: EyeContext<'a>, seed: u64 },
-    /// A solved radiosity scene seen from the camera.
     Radiosity(&'a Shading<'a>),
 }
 
