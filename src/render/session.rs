@@ -216,7 +216,10 @@ impl Session {
         progress: &Progress,
         snapshot: &mut dyn FnMut(u32, &Image),
     ) -> RenderOutput {
-        self.render_passes(&PixelIntegrator::Radiosity(shading), progress, snapshot)
+        let start = Instant::now();
+        let mut out = self.render_passes(&PixelIntegrator::Radiosity(shading), progress, snapshot);
+        out.seconds = start.elapsed().as_secs_f64();
+        out
     }
 
     /// The pass loop of the per-pixel integrators.
