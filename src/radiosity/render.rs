@@ -30,8 +30,8 @@ use crate::render::sampler::PixelSample;
 use crate::render::session::{Progress, RenderOutput, Session};
 use crate::render::world::World;
 
-/// Specular bounces followed before a camera path gives up.
-const MAX_SPECULAR_BOUNCES: u32 = 8;
+/// Specular bounces a camera path follows unless told otherwise.
+const DEFAULT_SPECULAR_DEPTH: u32 = 8;
 
 /// A solution prepared for shading camera rays.
 pub struct Shading<'a> {
@@ -43,6 +43,7 @@ pub struct Shading<'a> {
     /// Display radiosity per display vertex.
     vertex_radiosity: Vec<[f32; 3]>,
     final_gather: u32,
+    specular_depth: u32,
 }
 
 impl<'a> Shading<'a> {
@@ -77,7 +78,14 @@ impl<'a> Shading<'a> {
             mesh,
             vertex_radiosity,
             final_gather,
+            specular_depth: DEFAULT_SPECULAR_DEPTH,
         }
+    }
+
+    /// Follows at most `depth` specular bounces per camera ray.
+    pub fn with_specular_depth(mut self, depth: u32) -> Shading<'a> {
+        self.specular_depth = depth;
+        self
     }
 
     /// The display mesh (vertex positions, normals, corner map).
@@ -130,7 +138,7 @@ impl<'a> Shading<'a> {
         let mut beta = Rgb::WHITE;
         let mut l = Rgb::BLACK;
         let mut rays = 0u32;
-        for _ in 0..=MAX_SPECULAR_BOUNCES {
+        for _ in 0..=self.specular_depth {
             rays += 1;
             let Some(hit) = self.tracer.intersect(self.scene, &ray, f32::INFINITY) else {
                 break;
@@ -320,7 +328,8 @@ pub fn render_session(
         &display,
         &solution.irradiance,
         settings.final_gather,
-    );
+    )
+    .with_specular_depth(settings.max_depth);
     progress.done.store(0, Ordering::Relaxed);
     let mut out = session.render_shading(&shading, progress, snapshot);
     out.seconds = start.elapsed().as_secs_f64();

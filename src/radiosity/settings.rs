@@ -12,6 +12,7 @@
 //!     "integer finalgather" [0]         # gather rays per camera sample (0: Gouraud display)
 //!     "string visibility" "patches"     # or "world"
 //!     "bool twosided" [false]
+//!     "integer maxdepth" [8]            # specular bounces of camera rays (display)
 //! ```
 
 use crate::scene::{IntegratorDesc, SceneError};
@@ -69,6 +70,8 @@ pub struct RadiositySettings {
     pub visibility: VisibilitySource,
     /// Also mesh the back side of every non-emitting diffuse surface.
     pub two_sided: bool,
+    /// Specular bounces a camera ray follows (mirrors, glass) before it gives up.
+    pub max_depth: u32,
 }
 
 /// Patches aimed at when no `maxpatcharea` is given.
@@ -87,6 +90,7 @@ impl Default for RadiositySettings {
             final_gather: 0,
             visibility: VisibilitySource::Patches,
             two_sided: false,
+            max_depth: 8,
         }
     }
 }
@@ -203,6 +207,10 @@ impl RadiositySettings {
         // normal points to); true adds a back patch to every non-emitting diffuse face.
         // Example: `"bool twosided" true`.
         let two_sided = params.bool("twosided", false)?;
+        // "integer maxdepth" [8]: specular bounces (mirror, glass) a camera ray follows
+        // to the diffuse surface it shows; the solve itself is diffuse only.
+        // Example: `"integer maxdepth" [16]`.
+        let max_depth = params.count("maxdepth", defaults.max_depth)?;
         Ok(RadiositySettings {
             max_patch_area,
             subdivision,
@@ -214,6 +222,7 @@ impl RadiositySettings {
             final_gather,
             visibility,
             two_sided,
+            max_depth,
         })
     }
 }

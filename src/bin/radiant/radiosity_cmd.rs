@@ -252,7 +252,8 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
                     {
                         let display = state.display_radiosity(&scene.patches);
                         let shading =
-                            Shading::new(scene, &session.world, &display, &state.irradiance, 0);
+                            Shading::new(scene, &session.world, &display, &state.irradiance, 0)
+                                .with_specular_depth(settings.max_depth);
                         let frame_progress = Progress::default();
                         let out = session.render_shading(&shading, &frame_progress, &mut |_, _| {});
                         let path = frame_path(pattern, state.shots / every);
@@ -306,7 +307,8 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         &display,
         &solution.irradiance,
         settings.final_gather,
-    );
+    )
+    .with_specular_depth(settings.max_depth);
     if let Some(path) = &args.export {
         let mesh = LitMesh::new(scene, shading.mesh(), shading.vertex_radiosity());
         let is_ply = path
