@@ -13,6 +13,8 @@
 //! - [`report`]: reciprocity, closure, irradiance and energy balance.
 //! - [`shapes`]: meshed boxes and spheres for tests and benchmarks.
 
+pub mod adaptive;
+pub mod contact;
 pub mod contour;
 pub mod display;
 pub mod export;
@@ -24,6 +26,7 @@ pub mod mesh;
 pub mod patch;
 pub mod progressive;
 pub mod quadrature;
+pub mod refine;
 pub mod render;
 pub mod report;
 pub mod scene;

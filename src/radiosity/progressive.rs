@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use thiserror::Error;
 
 use super::formfactor::RayCaster;
-use super::hemicube::HemiCube;
+use super::hemicube::{HemiCube, HemiCubeBuffers};
 use super::matrix::FormFactorMatrix;
 use super::patch::PatchSet;
 use super::visibility::{InShot, ShotCull, Visibility};
@@ -29,6 +29,8 @@ pub enum ProgressiveError {
     Band(usize),
     #[error("{patches} patches but a {matrix} x {matrix} form-factor matrix")]
     MatrixSize { patches: usize, matrix: usize },
+    #[error("{patches} patches but a starting guess of {guess} radiosities")]
+    GuessSize { patches: usize, guess: usize },
 }
 
 /// How the next shooter is chosen.
@@ -89,6 +91,9 @@ pub struct ProgressiveState {
     pub absorbed: [f64; 3],
     pub escaped: [f64; 3],
     pub unshot_power: [f64; 3],
+    /// `sum_i A_i |dB_i|` per band: the unshot power, counting negative unshot
+    /// radiosity (left by a starting guess that was too bright) as much as positive.
+    pub unshot_magnitude: [f64; 3],
 }
 
 impl ProgressiveState {
@@ -105,14 +110,16 @@ impl ProgressiveState {
             absorbed: [0.0; 3],
             escaped: [0.0; 3],
             unshot_power: emitted,
+            unshot_magnitude: emitted,
         }
     }
 
-    /// Unshot power over emitted power, summed over bands (0 for a dark scene).
+    /// Unshot power (its magnitude) over emitted power, summed over bands (0 for a
+    /// dark scene).
     pub fn unshot_fraction(&self) -> f64 {
         let emitted: f64 = self.emitted.iter().sum();
         if emitted > 0.0 {
-            self.unshot_power.iter().sum::<f64>() / emitted
+            self.unshot_magnitude.iter().sum::<f64>() / emitted
         } else {
             0.0
         }
@@ -122,7 +129,7 @@ impl ProgressiveState {
     pub fn unshot_fraction_per_band(&self) -> [f64; 3] {
         std::array::from_fn(|b| {
             if self.emitted[b] > 0.0 {
-                self.unshot_power[b] / self.emitted[b]
+                self.unshot_magnitude[b] / self.emitted[b]
             } else {
                 0.0
             }
@@ -184,6 +191,7 @@ struct ShotPartial {
     incident: [f64; 3],
     absorbed: [f64; 3],
     unshot_power: [f64; 3],
+    unshot_magnitude: [f64; 3],
     best_score: f64,
     best: usize,
 }
@@ -196,6 +204,24 @@ pub fn solve_progressive<V: Visibility>(
     factors: ShootingFactors<'_>,
     vis: &V,
     settings: ProgressiveSettings,
+    on_progress: impl FnMut(&ProgressiveState) -> ControlFlow<()>,
+) -> Result<ProgressiveReport, ProgressiveError> {
+    solve_progressive_from(set, factors, vis, settings, None, on_progress)
+}
+
+/// [`solve_progressive`] from a starting guess of the radiosities (e.g. the solution
+/// of a coarser mesh). The guess `G` is treated as already shot: every patch first
+/// shoots its `G_j` once, which makes `B = E + rho F G` exact for that shot state, and
+/// its unshot radiosity becomes the residual `B - G`, positive or negative. Shooting
+/// then proceeds as usual on the magnitudes; with a good guess the residual starts
+/// near the tolerance, so the priming shots (one per patch) replace the many rounds a
+/// cold start needs. The power balance holds throughout.
+pub fn solve_progressive_from<V: Visibility>(
+    set: &PatchSet,
+    factors: ShootingFactors<'_>,
+    vis: &V,
+    settings: ProgressiveSettings,
+    guess: Option<&[[f64; 3]]>,
     mut on_progress: impl FnMut(&ProgressiveState) -> ControlFlow<()>,
 ) -> Result<ProgressiveReport, ProgressiveError> {
     let n = set.len();
@@ -212,43 +238,124 @@ pub fn solve_progressive<V: Visibility>(
             matrix: m.len(),
         });
     }
+    if let Some(g) = guess
+        && g.len() != n
+    {
+        return Err(ProgressiveError::GuessSize {
+            patches: n,
+            guess: g.len(),
+        });
+    }
     let mut state = ProgressiveState::new(set);
     let mut fractions = Vec::new();
     let mut fractions_per_band = Vec::new();
-    let mut hemicube_row = match factors {
-        ShootingFactors::HemiCube(_) => vec![0.0; n],
-        _ => Vec::new(),
+    let mut shooting = Shooting {
+        set,
+        factors,
+        vis,
+        selection: settings.selection,
+        hemicube_row: match factors {
+            ShootingFactors::HemiCube(_) => vec![0.0; n],
+            _ => Vec::new(),
+        },
+        hemicube_buffers: match factors {
+            ShootingFactors::HemiCube(h) => Some(h.buffers()),
+            _ => None,
+        },
+        shot_cull: ShotCull::default(),
+        cull: matches!(factors, ShootingFactors::RayCast(_)) && !vis.always_visible(),
     };
-    let mut hemicube_buffers = match factors {
-        ShootingFactors::HemiCube(h) => Some(h.buffers()),
-        _ => None,
-    };
-    // Occluders that matter per group of receivers for the current shooter.
-    let mut shot_cull = ShotCull::default();
-    let cull = matches!(factors, ShootingFactors::RayCast(_)) && !vis.always_visible();
     let fraction = |state: &ProgressiveState| match settings.selection {
         ShooterSelection::TotalPower => state.unshot_fraction(),
         ShooterSelection::Band(b) => state.unshot_fraction_per_band()[b],
     };
     let mut shooter = best_shooter(set, &state.unshot, settings.selection);
+    if let Some(g) = guess {
+        for (j, shot) in g.iter().enumerate() {
+            if *shot != [0.0; 3] {
+                shooting.shoot(&mut state, j, *shot);
+                state.shots += 1;
+            }
+        }
+        let mut unshot_power = [0.0; 3];
+        let mut unshot_magnitude = [0.0; 3];
+        for ((db, b), (patch, shot)) in state
+            .unshot
+            .iter_mut()
+            .zip(&state.radiosity)
+            .zip(set.patches.iter().zip(g))
+        {
+            for band in 0..3 {
+                db[band] = b[band] - shot[band];
+                unshot_power[band] += patch.area * db[band];
+                unshot_magnitude[band] += patch.area * db[band].abs();
+            }
+        }
+        state.unshot_power = unshot_power;
+        state.unshot_magnitude = unshot_magnitude;
+        shooter = best_shooter(set, &state.unshot, settings.selection);
+    }
     let mut converged = fraction(&state) <= settings.unshot_tolerance;
     let mut stopped = false;
     while !converged && !stopped && state.shots < settings.max_shots {
         let Some(i) = shooter else { break };
         let shot = state.unshot[i];
         state.unshot[i] = [0.0; 3];
-        let area_i = set.patches[i].area;
-        if let (ShootingFactors::HemiCube(h), Some(buffers)) = (factors, hemicube_buffers.as_mut())
+        shooter = shooting.shoot(&mut state, i, shot);
+        state.shots += 1;
+        fractions.push(state.unshot_fraction());
+        fractions_per_band.push(state.unshot_fraction_per_band());
+        converged = fraction(&state) <= settings.unshot_tolerance;
+        if settings.callback_every > 0
+            && state.shots.is_multiple_of(settings.callback_every)
+            && on_progress(&state).is_break()
         {
-            h.row(set, i, buffers, &mut hemicube_row);
+            stopped = !converged;
         }
-        if cull {
-            vis.prepare_shot(set, i, &mut shot_cull);
+    }
+    Ok(ProgressiveReport {
+        state,
+        unshot_fraction: fractions,
+        unshot_fraction_per_band: fractions_per_band,
+        converged,
+        stopped,
+    })
+}
+
+/// What one shot needs besides the state: factors, visibility and their scratch.
+struct Shooting<'a, V: Visibility> {
+    set: &'a PatchSet,
+    factors: ShootingFactors<'a>,
+    vis: &'a V,
+    selection: ShooterSelection,
+    hemicube_row: Vec<f64>,
+    hemicube_buffers: Option<HemiCubeBuffers>,
+    /// Occluders that matter per group of receivers for the current shooter.
+    shot_cull: ShotCull,
+    cull: bool,
+}
+
+impl<V: Visibility> Shooting<'_, V> {
+    /// Shoots radiosity `shot` from patch `i` to every receiver, books the power, and
+    /// returns the patch with the most unshot power afterwards.
+    fn shoot(&mut self, state: &mut ProgressiveState, i: usize, shot: [f64; 3]) -> Option<usize> {
+        let set = self.set;
+        let factors = self.factors;
+        let selection = self.selection;
+        let area_i = set.patches[i].area;
+        if let (ShootingFactors::HemiCube(h), Some(buffers)) =
+            (factors, self.hemicube_buffers.as_mut())
+        {
+            h.row(set, i, buffers, &mut self.hemicube_row);
+        }
+        if self.cull {
+            self.vis.prepare_shot(set, i, &mut self.shot_cull);
         }
         let in_shot = InShot {
-            vis,
-            shot: &shot_cull,
+            vis: self.vis,
+            shot: &self.shot_cull,
         };
+        let hemicube_row = &self.hemicube_row;
         // Gathering coefficient F_ji of each receiver j for this shooter.
         let coefficient = |j: usize| -> f64 {
             match factors {
@@ -286,7 +393,8 @@ pub fn solve_progressive<V: Visibility>(
                         }
                     }
                     add_scaled(&mut partial.unshot_power, db, patch.area);
-                    let score = selection_score(patch.area, db, settings.selection);
+                    add_scaled(&mut partial.unshot_magnitude, &db.map(f64::abs), patch.area);
+                    let score = selection_score(patch.area, db, selection);
                     if score > partial.best_score {
                         partial.best_score = score;
                         partial.best = j;
@@ -296,12 +404,14 @@ pub fn solve_progressive<V: Visibility>(
             })
             .collect();
         let mut best_score = 0.0;
-        shooter = None;
+        let mut shooter = None;
         let mut unshot_power = [0.0; 3];
+        let mut unshot_magnitude = [0.0; 3];
         for p in &partials {
             add_scaled(&mut state.absorbed, &p.absorbed, 1.0);
             add_scaled(&mut state.escaped, &p.incident, -1.0);
             add_scaled(&mut unshot_power, &p.unshot_power, 1.0);
+            add_scaled(&mut unshot_magnitude, &p.unshot_magnitude, 1.0);
             if p.best_score > best_score {
                 best_score = p.best_score;
                 shooter = Some(p.best);
@@ -309,24 +419,9 @@ pub fn solve_progressive<V: Visibility>(
         }
         add_scaled(&mut state.escaped, &shot, area_i);
         state.unshot_power = unshot_power;
-        state.shots += 1;
-        fractions.push(state.unshot_fraction());
-        fractions_per_band.push(state.unshot_fraction_per_band());
-        converged = fraction(&state) <= settings.unshot_tolerance;
-        if settings.callback_every > 0
-            && state.shots.is_multiple_of(settings.callback_every)
-            && on_progress(&state).is_break()
-        {
-            stopped = !converged;
-        }
+        state.unshot_magnitude = unshot_magnitude;
+        shooter
     }
-    Ok(ProgressiveReport {
-        state,
-        unshot_fraction: fractions,
-        unshot_fraction_per_band: fractions_per_band,
-        converged,
-        stopped,
-    })
 }
 
 /// `sum += scale * value`, per band.
@@ -340,8 +435,8 @@ fn add_scaled(sum: &mut [f64; 3], value: &[f64; 3], scale: f64) {
 #[inline]
 fn selection_score(area: f64, unshot: &[f64; 3], selection: ShooterSelection) -> f64 {
     match selection {
-        ShooterSelection::TotalPower => area * (unshot[0] + unshot[1] + unshot[2]),
-        ShooterSelection::Band(b) => area * unshot[b],
+        ShooterSelection::TotalPower => area * (unshot[0].abs() + unshot[1].abs() + unshot[2].abs()),
+        ShooterSelection::Band(b) => area * unshot[b].abs(),
     }
 }
 

@@ -17,7 +17,8 @@ use glam::{DVec3, Vec3};
 use super::display::{DisplayMesh, PatchTracer};
 use super::scene::RadiosityScene;
 use super::settings::{RadiositySettings, VisibilitySource};
-use super::solve::{RadiosityStats, Solution, SolveEvent, solve};
+use super::adaptive::{AdaptiveSolution, solve_adaptive};
+use super::solve::{RadiosityStats, SolveEvent};
 use super::world_visibility::{FaceVisibility, SceneVisibility, WorldVisibility};
 use crate::color::Rgb;
 use crate::image::Image;
@@ -273,24 +274,24 @@ pub fn scene_visibility<'a>(
     }
 }
 
-/// Solves the session's radiosity scene, reporting progress in thousandths of the way
-/// to convergence on `progress` and stopping on its cancel flag.
+/// Solves the session's radiosity scene (refining it as the settings ask), reporting
+/// progress in thousandths of the way to convergence on `progress` and stopping on its
+/// cancel flag.
 pub fn solve_session(
     session: &Session,
     scene: &RadiosityScene,
     settings: &RadiositySettings,
     progress: &Progress,
-) -> Solution {
-    let vis = scene_visibility(scene, &session.world, settings);
+) -> AdaptiveSolution {
     progress.total.store(1000, Ordering::Relaxed);
     progress.done.store(0, Ordering::Relaxed);
     let sphere = session.world.scene_sphere();
-    solve(
+    solve_adaptive(
         scene,
         &session.world.lights,
         sphere,
         settings,
-        &vis,
+        |mesh| scene_visibility(mesh, &session.world, settings),
         |event| {
             let done = match event {
                 SolveEvent::Shot { fraction_done, .. } => (1000.0 * fraction_done) as u64,
@@ -320,7 +321,9 @@ pub fn render_session(
     snapshot: &mut dyn FnMut(u32, &Image),
 ) -> RenderOutput {
     let start = std::time::Instant::now();
-    let solution = solve_session(session, scene, settings, progress);
+    let solved = solve_session(session, scene, settings, progress);
+    let scene = solved.scene(scene);
+    let solution = &solved.solution;
     let display = solution.display_radiosity(&scene.patches);
     let shading = Shading::new(
         scene,

@@ -13,6 +13,9 @@
 //!     "string visibility" "patches"     # or "world"
 //!     "bool twosided" [false]
 //!     "integer maxdepth" [8]            # specular bounces of camera rays (display)
+//!     "integer refine" [0]              # adaptive refinement passes (0: none)
+//!     "float refinethreshold" [0.1]     # neighbour contrast that splits patches
+//!     "integer contactgrading" [0]      # a-priori rows halving towards contact edges
 //! ```
 
 use crate::scene::{IntegratorDesc, SceneError};
@@ -72,6 +75,16 @@ pub struct RadiositySettings {
     pub two_sided: bool,
     /// Specular bounces a camera ray follows (mirrors, glass) before it gives up.
     pub max_depth: u32,
+    /// Adaptive refinement passes: solve, split the patches whose radiosity differs
+    /// from a neighbour's by more than `refine_threshold`, solve again (see
+    /// [`super::adaptive`]). 0 solves the first mesh only.
+    pub refine: u32,
+    /// Relative radiosity contrast between neighbouring patches of one surface above
+    /// which both are split.
+    pub refine_threshold: f64,
+    /// Levels of a-priori grading towards contact edges (a block on the floor): the
+    /// elements touching one are split this many times over (see [`super::contact`]).
+    pub contact_grading: u32,
 }
 
 /// Patches aimed at when no `maxpatcharea` is given.
@@ -91,6 +104,9 @@ impl Default for RadiositySettings {
             visibility: VisibilitySource::Patches,
             two_sided: false,
             max_depth: 8,
+            refine: 0,
+            refine_threshold: 0.1,
+            contact_grading: 0,
         }
     }
 }
@@ -211,6 +227,37 @@ impl RadiositySettings {
         // to the diffuse surface it shows; the solve itself is diffuse only.
         // Example: `"integer maxdepth" [16]`.
         let max_depth = params.count("maxdepth", defaults.max_depth)?;
+        // "integer refine" [0]: adaptive refinement passes. Each solves the current
+        // mesh, splits the patches whose radiosity differs from a neighbour's on the
+        // same surface by more than "refinethreshold" (shadow boundaries, contact
+        // shadows) and their neighbours as far as the mesh must stay conforming, then
+        // solves again. Example: `"integer refine" [3]`.
+        let refine = params.count("refine", defaults.refine)?;
+        if refine > 12 {
+            return Err(bad("refine", format!("must lie in 0..=12, got {refine}")));
+        }
+        // "float refinethreshold" [0.1]: the relative contrast |B_i - B_k| / max(B_i,
+        // B_k) (largest over the bands) between neighbours that splits both.
+        // Example: `"float refinethreshold" [0.05]`.
+        let refine_threshold =
+            params.finite_float("refinethreshold", defaults.refine_threshold as f32)? as f64;
+        if !(refine_threshold > 0.0) {
+            return Err(bad(
+                "refinethreshold",
+                format!("must be positive, got {refine_threshold}"),
+            ));
+        }
+        // "integer contactgrading" [0]: before the first solve, split the elements that
+        // touch a contact edge (where a surface rests on another it shares no edge
+        // with, such as a block on the floor) this many times over, so rows of
+        // elements halve towards the contact line. Example: `"integer contactgrading" [3]`.
+        let contact_grading = params.count("contactgrading", defaults.contact_grading)?;
+        if contact_grading > 12 {
+            return Err(bad(
+                "contactgrading",
+                format!("must lie in 0..=12, got {contact_grading}"),
+            ));
+        }
         Ok(RadiositySettings {
             max_patch_area,
             subdivision,
@@ -223,6 +270,9 @@ impl RadiositySettings {
             visibility,
             two_sided,
             max_depth,
+            refine,
+            refine_threshold,
+            contact_grading,
         })
     }
 }

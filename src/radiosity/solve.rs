@@ -20,7 +20,7 @@ use super::matrix::FormFactorMatrix;
 use super::patch::PatchSet;
 use super::progressive::{
     ProgressiveError, ProgressiveSettings, ProgressiveState, ShooterSelection, ShootingFactors,
-    solve_progressive,
+    solve_progressive_from,
 };
 use super::quadrature::{PatchRule, Rule1D};
 use super::report;
@@ -153,8 +153,10 @@ pub enum SolveEvent<'a> {
     /// A matrix-solver sweep finished.
     Sweep { sweep: usize, residual: f64 },
     /// A progressive shot finished; `fraction_done` runs from 0 to 1 on a log scale of
-    /// the unshot power.
+    /// the unshot power. `scene` is the mesh the state belongs to (it changes between
+    /// the passes of an adaptive solve).
     Shot {
+        scene: &'a RadiosityScene,
         state: &'a ProgressiveState,
         fraction_done: f64,
     },
@@ -238,6 +240,21 @@ pub fn solve<V: Visibility>(
     sphere: SceneSphere,
     settings: &RadiositySettings,
     vis: &V,
+    on_event: impl FnMut(SolveEvent<'_>) -> ControlFlow<()>,
+) -> Result<Solution, RadiosityError> {
+    solve_from(scene, lights, sphere, settings, vis, None, on_event)
+}
+
+/// [`solve`] from a starting guess of every patch's radiosity (progressive refinement
+/// only, see [`super::progressive::solve_progressive_from`]; the matrix solvers start
+/// from the emission as always).
+pub fn solve_from<V: Visibility>(
+    scene: &RadiosityScene,
+    lights: &[Light],
+    sphere: SceneSphere,
+    settings: &RadiositySettings,
+    vis: &V,
+    guess: Option<&[[f64; 3]]>,
     mut on_event: impl FnMut(SolveEvent<'_>) -> ControlFlow<()>,
 ) -> Result<Solution, RadiosityError> {
     let start = Instant::now();
@@ -270,7 +287,7 @@ pub fn solve<V: Visibility>(
                 }
             };
             let log_tolerance = settings.tolerance.ln();
-            let report = solve_progressive(
+            let report = solve_progressive_from(
                 set,
                 factors,
                 vis,
@@ -280,10 +297,12 @@ pub fn solve<V: Visibility>(
                     selection: ShooterSelection::TotalPower,
                     callback_every: 1,
                 },
+                guess,
                 |state| {
                     let fraction = state.unshot_fraction().max(f64::MIN_POSITIVE);
                     let fraction_done = (fraction.ln() / log_tolerance).clamp(0.0, 1.0);
                     on_event(SolveEvent::Shot {
+                        scene,
                         state,
                         fraction_done,
                     })

@@ -10,3 +10,4 @@ mod formfactors;
 mod hemicube;
 mod meshes;
 mod pipeline;
+mod refinement;

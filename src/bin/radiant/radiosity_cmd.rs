@@ -13,7 +13,8 @@ use clap::Args;
 use radiant::image::{ImageMeta, write_image};
 use radiant::radiosity::export::{LitMesh, write_lit_mesh, write_patch_csv, write_ply};
 use radiant::radiosity::render::{Shading, scene_visibility};
-use radiant::radiosity::solve::{SolveEvent, solve};
+use radiant::radiosity::adaptive::solve_adaptive;
+use radiant::radiosity::solve::SolveEvent;
 use radiant::render::integrator::Integrator;
 use radiant::render::{Overrides, Progress, Session};
 use radiant::scene::{FileLoc, Param, ParamValue};
@@ -72,6 +73,15 @@ pub struct RadiosityArgs {
     /// Mesh the back side of non-emitting diffuse surfaces too ("twosided").
     #[arg(long)]
     pub two_sided: bool,
+    /// Adaptive refinement passes: split patches of strong contrast and solve again ("refine").
+    #[arg(long, value_name = "PASSES")]
+    pub refine: Option<u32>,
+    /// Neighbour radiosity contrast that splits patches ("refinethreshold").
+    #[arg(long)]
+    pub refine_threshold: Option<f32>,
+    /// Rows of elements halving towards contact edges, this many levels ("contactgrading").
+    #[arg(long, value_name = "LEVELS")]
+    pub contact_grading: Option<u32>,
     /// Samples per pixel of the images.
     #[arg(long)]
     pub spp: Option<u32>,
@@ -126,6 +136,15 @@ impl RadiosityArgs {
         }
         if self.two_sided {
             push("twosided", ParamValue::Bool(vec![true]));
+        }
+        if let Some(v) = self.refine {
+            push("refine", ParamValue::Int(vec![v as i32]));
+        }
+        if let Some(v) = self.refine_threshold {
+            push("refinethreshold", ParamValue::Float(vec![v]));
+        }
+        if let Some(v) = self.contact_grading {
+            push("contactgrading", ParamValue::Int(vec![v as i32]));
         }
         out
     }
@@ -218,9 +237,8 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
     }
 
     // Solve, writing the progressive sequence on the way.
-    let vis = scene_visibility(scene, &session.world, settings);
     let mut frame_error = None;
-    let solution = std::thread::scope(|s| {
+    let solved = std::thread::scope(|s| {
         let bar_done = Arc::new(std::sync::atomic::AtomicBool::new(false));
         if show_bar {
             let progress = Arc::clone(&progress);
@@ -229,12 +247,12 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         }
         progress.total.store(1000, Ordering::Relaxed);
         let solved = pool.install(|| {
-            solve(
+            solve_adaptive(
                 scene,
                 &session.world.lights,
                 session.world.scene_sphere(),
                 settings,
-                &vis,
+                |mesh| scene_visibility(mesh, &session.world, settings),
                 |event| {
                     let done = match &event {
                         SolveEvent::Shot { fraction_done, .. } => (1000.0 * fraction_done) as u64,
@@ -244,15 +262,15 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
                         SolveEvent::Sweep { .. } => 900,
                     };
                     progress.done.store(done, Ordering::Relaxed);
-                    if let (SolveEvent::Shot { state, .. }, Some(every), Some(pattern)) =
+                    if let (SolveEvent::Shot { scene: mesh, state, .. }, Some(every), Some(pattern)) =
                         (&event, args.every, &args.sequence)
                         && every > 0
                         && state.shots.is_multiple_of(every)
                         && frame_error.is_none()
                     {
-                        let display = state.display_radiosity(&scene.patches);
+                        let display = state.display_radiosity(&mesh.patches);
                         let shading =
-                            Shading::new(scene, &session.world, &display, &state.irradiance, 0)
+                            Shading::new(mesh, &session.world, &display, &state.irradiance, 0)
                                 .with_specular_depth(settings.max_depth);
                         let frame_progress = Progress::default();
                         let out = session.render_shading(&shading, &frame_progress, &mut |_, _| {});
@@ -279,6 +297,15 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
     })?;
     if let Some(e) = frame_error {
         return Err(e);
+    }
+    let scene = solved.scene(scene);
+    let solution = &solved.solution;
+    if !args.quiet && solved.passes > 0 {
+        eprintln!(
+            "refined: {} passes, {} patches",
+            solved.passes,
+            scene.patches.len()
+        );
     }
     if !args.quiet {
         eprintln!(
@@ -329,7 +356,7 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         }
     }
     if let Some(path) = &args.patches {
-        write_patch_csv(path, scene, &solution)?;
+        write_patch_csv(path, scene, solution)?;
     }
     let wrote_something =
         args.export.is_some() || args.patches.is_some() || args.sequence.is_some();
