@@ -122,7 +122,7 @@ impl RadiosityScene {
             .iter()
             .zip(&shape_tags)
             .filter(|(_, t)| t.is_some())
-            .map(|((s, xf), _)| shape_area(s, xf))
+            .map(|((s, xf), _)| s.geometry.surface_area(&xf.as_mat4()) as f64)
             .sum();
         let max_area = settings
             .max_patch_area
@@ -215,59 +215,6 @@ fn flatten(desc: &SceneDesc) -> Vec<(ShapeDesc, DMat4)> {
 /// Uniform scale of an affine map (cube root of the determinant's magnitude).
 fn scale_of(xf: &DMat4) -> f64 {
     xf.determinant().abs().cbrt()
-}
-
-/// Approximate render-space area of a shape (exact for meshes and similarities).
-fn shape_area(shape: &ShapeDesc, xf: &DMat4) -> f64 {
-    let s2 = scale_of(xf).powi(2);
-    match &shape.geometry {
-        Geometry::TriangleMesh {
-            positions, indices, ..
-        } => indices
-            .chunks_exact(3)
-            .map(|t| {
-                let p = [t[0], t[1], t[2]]
-                    .map(|i| xf.transform_point3(positions[i as usize].as_dvec3()));
-                0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length()
-            })
-            .sum(),
-        Geometry::BilinearMesh {
-            positions, indices, ..
-        } => indices
-            .chunks_exact(4)
-            .map(|q| {
-                let p = [q[0], q[1], q[3], q[2]]
-                    .map(|i| xf.transform_point3(positions[i as usize].as_dvec3()));
-                0.5 * ((p[1] - p[0]).cross(p[2] - p[0]).length()
-                    + (p[2] - p[0]).cross(p[3] - p[0]).length())
-            })
-            .sum(),
-        Geometry::Sphere {
-            radius,
-            z_min,
-            z_max,
-            phi_max_deg,
-        } => {
-            let (zl, zh) = sphere_z_range(*radius, *z_min, *z_max);
-            (*phi_max_deg as f64)
-                .to_radians()
-                .clamp(0.0, std::f64::consts::TAU)
-                * *radius as f64
-                * (zh - zl)
-                * s2
-        }
-        Geometry::Disk {
-            radius,
-            inner_radius,
-            phi_max_deg,
-            ..
-        } => {
-            let phi = (*phi_max_deg as f64)
-                .to_radians()
-                .clamp(0.0, std::f64::consts::TAU);
-            0.5 * phi * ((*radius as f64).powi(2) - (*inner_radius as f64).powi(2)).max(0.0) * s2
-        }
-    }
 }
 
 fn sphere_z_range(radius: f32, z_min: f32, z_max: f32) -> (f64, f64) {

@@ -261,6 +261,61 @@ pub enum LightDesc {
     Infinite { radiance: Rgb, loc: FileLoc },
 }
 
+impl Geometry {
+    /// Surface area in render space. Meshes are measured after the transform; spheres
+    /// and disks by their object-space formula times the transform's mean area scale
+    /// |det|^(2/3) (exact for uniform scales). Used for light `power` and default patch sizes.
+    pub fn surface_area(&self, render_from_object: &glam::Mat4) -> f32 {
+        let area_scale = glam::Mat3::from_mat4(*render_from_object)
+            .determinant()
+            .abs()
+            .powf(2.0 / 3.0);
+        let point = |p: Vec3| render_from_object.transform_point3(p);
+        let phi = |deg: f32| deg.to_radians().clamp(0.0, std::f32::consts::TAU);
+        match self {
+            Geometry::TriangleMesh {
+                positions, indices, ..
+            } => indices
+                .chunks_exact(3)
+                .map(|tri| {
+                    let [a, b, c] = [0, 1, 2].map(|k| point(positions[tri[k] as usize]));
+                    0.5 * (b - a).cross(c - a).length()
+                })
+                .sum(),
+            Geometry::BilinearMesh {
+                positions, indices, ..
+            } => indices
+                .chunks_exact(4)
+                .map(|q| {
+                    super::mesh::bilinear_patch_area(
+                        [0, 1, 2, 3].map(|k| point(positions[q[k] as usize])),
+                    )
+                })
+                .sum(),
+            Geometry::Sphere {
+                radius,
+                z_min,
+                z_max,
+                phi_max_deg,
+            } => {
+                let r = radius.abs();
+                let (a, b) = (z_min.clamp(-r, r), z_max.clamp(-r, r));
+                phi(*phi_max_deg) * r * (a - b).abs() * area_scale
+            }
+            Geometry::Disk {
+                radius,
+                inner_radius,
+                phi_max_deg,
+                ..
+            } => {
+                0.5 * phi(*phi_max_deg)
+                    * (radius * radius - inner_radius * inner_radius).max(0.0)
+                    * area_scale
+            }
+        }
+    }
+}
+
 impl SceneDesc {
     /// The file name to write: the film's, or a default.
     pub fn output_name(&self) -> &str {

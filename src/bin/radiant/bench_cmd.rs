@@ -25,11 +25,9 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         .build()?;
     pool.install(|| {
         let reps = if args.quick { 2 } else { 5 };
-        println!("== rays through the world, cornell-box (36 triangles), 1024x1024 camera");
-        println!(
-            "{}",
-            world_ray_benchmark(&cornell_box(), if args.quick { 256 } else { 1024 }, reps)
-        );
+        let size = if args.quick { 256 } else { 1024 };
+        println!("== rays through the world, cornell-box (36 triangles), {size}x{size} camera");
+        println!("{}", world_ray_benchmark(&cornell_box(), size, reps));
         println!("== rays, displaced sphere of ~1M triangles inside the Cornell box");
         let config = RayBenchConfig {
             subdivision: if args.quick { 64 } else { 224 },

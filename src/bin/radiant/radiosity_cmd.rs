@@ -19,7 +19,7 @@ use radiant::render::integrator::Integrator;
 use radiant::render::{Overrides, Progress, Session};
 use radiant::scene::{FileLoc, Param, ParamValue};
 
-use crate::render_cmd::{draw_progress, load_scene};
+use crate::render_cmd::{draw_progress, interruptible_progress, load_scene, worker_pool};
 
 #[derive(Args, Debug)]
 pub struct RadiosityArgs {
@@ -206,20 +206,8 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
     else {
         bail!("the session did not set up radiosity");
     };
-    let progress = Arc::new(Progress::default());
-    {
-        let progress = Arc::clone(&progress);
-        ctrlc::set_handler(move || {
-            if progress.cancel.swap(true, Ordering::SeqCst) {
-                std::process::exit(130);
-            }
-        })
-        .context("installing the Ctrl-C handler")?;
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
-        .build()
-        .context("starting worker threads")?;
+    let progress = interruptible_progress()?;
+    let pool = worker_pool(args.threads)?;
     let show_bar = !args.quiet && std::io::stderr().is_terminal();
     let meta = |spp: u32, seconds: f64| ImageMeta {
         samples_per_pixel: Some(spp),

@@ -109,21 +109,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(desc.output_name()));
 
-    let progress = Arc::new(Progress::default());
-    {
-        let progress = Arc::clone(&progress);
-        // A second Ctrl-C while the partial image is written still stops at once.
-        ctrlc::set_handler(move || {
-            if progress.cancel.swap(true, Ordering::SeqCst) {
-                std::process::exit(130);
-            }
-        })
-        .context("installing the Ctrl-C handler")?;
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
-        .build()
-        .context("starting worker threads")?;
+    let progress = interruptible_progress()?;
+    let pool = worker_pool(args.threads)?;
     let show_bar = !args.quiet && std::io::stderr().is_terminal();
     let output_data = std::thread::scope(|scope| {
         let bar_done = Arc::new(std::sync::atomic::AtomicBool::new(false));
@@ -206,6 +193,28 @@ fn snapshot_path(output: &Path, n: u32) -> PathBuf {
         None => format!("{stem}-{n:05}"),
     };
     output.with_file_name(name)
+}
+
+/// Progress counters whose `cancel` flag Ctrl-C sets; the render then stops and the
+/// image so far is written. A second Ctrl-C (while that image is written) exits at once.
+pub fn interruptible_progress() -> anyhow::Result<Arc<Progress>> {
+    let progress = Arc::new(Progress::default());
+    let flag = Arc::clone(&progress);
+    ctrlc::set_handler(move || {
+        if flag.cancel.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    })
+    .context("installing the Ctrl-C handler")?;
+    Ok(progress)
+}
+
+/// The rayon pool for `--threads` (all cores when `None`).
+pub fn worker_pool(threads: Option<usize>) -> anyhow::Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .context("starting worker threads")
 }
 
 pub fn draw_progress(progress: &Progress, done: &std::sync::atomic::AtomicBool) {

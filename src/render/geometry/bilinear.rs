@@ -221,31 +221,10 @@ impl BilinearPatch {
         dpdu.cross(dpdv).length()
     }
 
-    /// Surface area by 5×5-point Gauss–Legendre quadrature of the area element (exact for
-    /// parallelograms; for curved patches the element is smooth and the rule converges fast).
+    /// Surface area: the integral of the area element by Gauss–Legendre quadrature
+    /// (exact for parallelograms; the element is smooth, so it converges fast).
     pub fn area(&self) -> f32 {
-        const X: [f64; 5] = [
-            0.0,
-            -0.538_469_310_105_683_1,
-            0.538_469_310_105_683_1,
-            -0.906_179_845_938_664,
-            0.906_179_845_938_664,
-        ];
-        const W: [f64; 5] = [
-            0.568_888_888_888_888_9,
-            0.478_628_670_499_366_5,
-            0.478_628_670_499_366_5,
-            0.236_926_885_056_189_1,
-            0.236_926_885_056_189_1,
-        ];
-        let mut sum = 0.0;
-        for (xi, wi) in X.iter().zip(W) {
-            for (xj, wj) in X.iter().zip(W) {
-                let uv = Vec2::new((0.5 * (xi + 1.0)) as f32, (0.5 * (xj + 1.0)) as f32);
-                sum += 0.25 * wi * wj * self.jacobian(uv) as f64;
-            }
-        }
-        sum as f32
+        crate::scene::mesh::bilinear_patch_area([self.p00, self.p10, self.p01, self.p11])
     }
 
     /// Samples (u,v) uniformly in the unit square and maps it onto the patch. This is not

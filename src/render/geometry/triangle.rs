@@ -155,77 +155,18 @@ pub fn sample_triangle(p0: Vec3, p1: Vec3, p2: Vec3, u: Vec2) -> Option<AreaSamp
 mod tests {
     use super::*;
     use crate::math::hash::Pcg32;
-    use std::collections::HashMap;
 
     fn rand_vec(rng: &mut Pcg32) -> Vec3 {
         Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - Vec3::ONE
-    }
-
-    /// A closed icosphere (level-2 subdivision, shared vertices).
-    fn icosphere(levels: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-        let t = (1.0 + 5f32.sqrt()) / 2.0;
-        let mut v: Vec<Vec3> = [
-            (-1., t, 0.),
-            (1., t, 0.),
-            (-1., -t, 0.),
-            (1., -t, 0.),
-            (0., -1., t),
-            (0., 1., t),
-            (0., -1., -t),
-            (0., 1., -t),
-            (t, 0., -1.),
-            (t, 0., 1.),
-            (-t, 0., -1.),
-            (-t, 0., 1.),
-        ]
-        .iter()
-        .map(|&(x, y, z)| Vec3::new(x, y, z).normalize())
-        .collect();
-        let mut f: Vec<[u32; 3]> = vec![
-            [0, 11, 5],
-            [0, 5, 1],
-            [0, 1, 7],
-            [0, 7, 10],
-            [0, 10, 11],
-            [1, 5, 9],
-            [5, 11, 4],
-            [11, 10, 2],
-            [10, 7, 6],
-            [7, 1, 8],
-            [3, 9, 4],
-            [3, 4, 2],
-            [3, 2, 6],
-            [3, 6, 8],
-            [3, 8, 9],
-            [4, 9, 5],
-            [2, 4, 11],
-            [6, 2, 10],
-            [8, 6, 7],
-            [9, 8, 1],
-        ];
-        for _ in 0..levels {
-            let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-            let mut next = Vec::new();
-            for &[a, b, c] in &f {
-                let mut m = |i: u32, j: u32| {
-                    *mid.entry((i.min(j), i.max(j))).or_insert_with(|| {
-                        v.push((v[i as usize] + v[j as usize]).normalize());
-                        v.len() as u32 - 1
-                    })
-                };
-                let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-                next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-            }
-            f = next;
-        }
-        (v, f)
     }
 
     #[test]
     fn rays_at_shared_edges_and_vertices_never_fall_through() {
         // Rays from points inside a closed mesh, aimed exactly at vertices and at
         // points on shared edges (where non-watertight tests leak), must hit something.
-        let (v, f) = icosphere(2);
+        // A closed geodesic sphere with shared vertices (320 triangles).
+        let mesh = crate::render::accel::displaced_sphere::geodesic_sphere(4);
+        let (v, f) = (mesh.vertices, mesh.triangles);
         let mut rng = Pcg32::new(11, 3);
         let mut misses = 0;
         let mut rays = 0;

@@ -14,16 +14,13 @@
 
 use std::path::Path;
 
-use glam::{Mat3, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 
 use super::Parser;
 use super::state::with_defaults;
-use crate::math::Transform;
 use crate::scene::desc::{AreaLightDesc, Geometry, ShapeDesc};
 use crate::scene::error::{FileLoc, SceneError};
-use crate::scene::mesh::{
-    MeshData, bilinear_patch_area, first_non_finite2, first_non_finite3, first_out_of_range,
-};
+use crate::scene::mesh::{MeshData, first_non_finite2, first_non_finite3, first_out_of_range};
 use crate::scene::params::{ParamSet, ParamValue};
 use crate::scene::{obj, ply};
 
@@ -91,7 +88,7 @@ impl Parser {
                     // Φ = π A L per emitting side for a Lambertian emitter.
                     let area: f32 = geometries
                         .iter()
-                        .map(|g| render_area(g, &render_from_object))
+                        .map(|g| g.surface_area(&render_from_object.m))
                         .sum();
                     let sides = if al.two_sided { 2.0 } else { 1.0 };
                     let y = l.luminance();
@@ -386,44 +383,4 @@ fn disk(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
         inner_radius: positive(ps, "innerradius", 0.0, true, loc)?,
         phi_max_deg: ps.finite_float("phimax", 360.0)?.clamp(0.0, 360.0),
     })
-}
-
-/// Surface area in render space (for `power`). Meshes are measured after the
-/// transform; spheres and disks by their object-space formula times the transform's
-/// mean area scale |det|^(2/3) (exact for uniform scales).
-pub(super) fn render_area(g: &Geometry, t: &Transform) -> f32 {
-    let area_scale = Mat3::from_mat4(t.m).determinant().abs().powf(2.0 / 3.0);
-    match g {
-        Geometry::TriangleMesh {
-            positions, indices, ..
-        } => indices
-            .chunks_exact(3)
-            .map(|tri| {
-                let [a, b, c] = [0, 1, 2].map(|k| t.point(positions[tri[k] as usize]));
-                0.5 * (b - a).cross(c - a).length()
-            })
-            .sum(),
-        Geometry::BilinearMesh {
-            positions, indices, ..
-        } => indices
-            .chunks_exact(4)
-            .map(|q| bilinear_patch_area([0, 1, 2, 3].map(|k| t.point(positions[q[k] as usize]))))
-            .sum(),
-        Geometry::Sphere {
-            radius,
-            z_min,
-            z_max,
-            phi_max_deg,
-        } => phi_max_deg.to_radians() * radius * (z_max - z_min) * area_scale,
-        Geometry::Disk {
-            radius,
-            inner_radius,
-            phi_max_deg,
-            ..
-        } => {
-            0.5 * phi_max_deg.to_radians()
-                * (radius * radius - inner_radius * inner_radius)
-                * area_scale
-        }
-    }
 }
