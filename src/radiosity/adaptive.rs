@@ -82,17 +82,12 @@ pub fn contrast_marks(
             {
                 continue;
             }
-            let contrast = if std::env::var("LUM").is_ok() {
-                let w = [0.2126, 0.7152, 0.0722];
-                let (x, y) = ((0..3).map(|b| w[b] * radiosity[i][b]).sum::<f64>(), (0..3).map(|b| w[b] * radiosity[j][b]).sum::<f64>());
-                let fl = (0..3).map(|b| w[b] * floor[b]).sum::<f64>();
-                (x - y).abs() / x.max(y).max(fl).max(f64::MIN_POSITIVE)
-            } else { (0..3)
+            let contrast = (0..3)
                 .map(|b| {
                     let (x, y) = (radiosity[i][b], radiosity[j][b]);
                     (x - y).abs() / x.max(y).max(floor[b]).max(f64::MIN_POSITIVE)
                 })
-                .fold(0.0, f64::max) };
+                .fold(0.0, f64::max);
             if contrast > threshold {
                 marked[i] = true;
                 marked[j] = true;
@@ -187,7 +182,12 @@ pub fn solve_adaptive<V: Visibility>(
             return finish(current, solution, done);
         }
         let display = solution.display_radiosity(&mesh.patches);
-        let marked = contrast_marks(mesh, &display, &solution.irradiance, settings.refine_threshold);
+        let marked = contrast_marks(
+            mesh,
+            &display,
+            &solution.irradiance,
+            settings.refine_threshold,
+        );
         let forest = refinement.get_or_insert_with(|| Refinement::new(scene.clone()));
         // The mesh just solved as the forest sees it (the unrefined scene is its roots).
         let solved_base = current.is_none();

@@ -86,8 +86,14 @@ impl ContactFinder {
                 continue;
             }
             let lo = corners.iter().copied().fold(DVec3::INFINITY, DVec3::min);
-            let hi = corners.iter().copied().fold(DVec3::NEG_INFINITY, DVec3::max);
-            let (a, b) = (finder.key(lo - DVec3::splat(reach)), finder.key(hi + DVec3::splat(reach)));
+            let hi = corners
+                .iter()
+                .copied()
+                .fold(DVec3::NEG_INFINITY, DVec3::max);
+            let (a, b) = (
+                finder.key(lo - DVec3::splat(reach)),
+                finder.key(hi + DVec3::splat(reach)),
+            );
             let count = (0..3).map(|k| b[k] - a[k] + 1).product::<i64>();
             if count > MAX_CELLS_PER_FACE {
                 finder.large.push(f as u32);
@@ -125,7 +131,11 @@ impl ContactFinder {
     /// `reach` of a face it does not share a point with, the two facing each other.
     pub fn touches(&self, face: u32, corners: &[DVec3], normal: DVec3, reach: f64) -> bool {
         let lo = corners.iter().copied().fold(DVec3::INFINITY, DVec3::min) - DVec3::splat(reach);
-        let hi = corners.iter().copied().fold(DVec3::NEG_INFINITY, DVec3::max) + DVec3::splat(reach);
+        let hi = corners
+            .iter()
+            .copied()
+            .fold(DVec3::NEG_INFINITY, DVec3::max)
+            + DVec3::splat(reach);
         let (a, b) = (self.key(lo), self.key(hi));
         let centroid = corners.iter().copied().sum::<DVec3>() / corners.len() as f64;
         let mut seen: Vec<u32> = Vec::new();
@@ -142,7 +152,8 @@ impl ContactFinder {
         candidates.sort_unstable();
         candidates.dedup();
         for g in candidates {
-            if g == face || self.adjacent.contains(&(face.min(g), face.max(g))) || seen.contains(&g) {
+            if g == face || self.adjacent.contains(&(face.min(g), face.max(g))) || seen.contains(&g)
+            {
                 continue;
             }
             seen.push(g);
@@ -278,7 +289,10 @@ mod tests {
             p(&mut mesh, 10.0, 0.0, 10.0),
         ];
         mesh.add_face(&floor, 0);
-        let top = [p(&mut mesh, 0.0, 10.0, 10.0), p(&mut mesh, 10.0, 10.0, 10.0)];
+        let top = [
+            p(&mut mesh, 0.0, 10.0, 10.0),
+            p(&mut mesh, 10.0, 10.0, 10.0),
+        ];
         mesh.add_face(&[floor[3], floor[2], top[0], top[1]], 0);
         let block = [
             p(&mut mesh, 6.0, 0.0, 5.0),

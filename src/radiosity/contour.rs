@@ -130,47 +130,6 @@ pub fn point_disk_approximation(
         / (distance_squared * (std::f64::consts::PI * distance_squared + area))
 }
 
-/// The far-field factor from the point `x` (unit normal `n`) to a small planar patch
-/// with centroid `centre`, unit normal `source_normal` and area `area`, to second order
-/// in the patch size: the point-to-point kernel at the centroid plus the mean of its
-/// second derivatives over the patch.
-///
-/// In the patch plane, with `u` the offset from the centroid, the kernel is
-/// `K(u) = h (a + b.u) / (pi r^4)`: `h` the height of `x` above the plane, `a = n . d`
-/// for `d = centre - x`, `b` the in-plane part of `n`, `r^2 = h^2 + |rho + u|^2` and
-/// `rho` the in-plane part of `d`. The first-order term vanishes over the patch (the
-/// centroid is its mean), and the second-order term is `(1/2) sum_ij d_ij K <u_i u_j>`.
-/// Taking the second moments of a square, `<u_i u_j> = (A / 12) delta_ij`, gives
-/// `F = A K(0) + (A^2 / 24) Laplacian K(0)` with
-/// `Laplacian K(0) = (h / pi) [a (16 rho^2 - 8 h^2) / r^8 - 8 b . rho / r^6]`.
-/// The correction is negative when the patch is seen face on and positive when it is
-/// seen at a grazing angle; the disk formula [`point_disk_approximation`] always
-/// applies the face-on one, which biases it low on average (-0.13 % over the far pairs
-/// of the Cornell box beyond 8 patch sizes, against -0.01 % here, with a tenth of its
-/// mean error). Zero when the centroid is behind either side.
-#[inline]
-pub fn point_patch_far_field(
-    x: DVec3,
-    n: DVec3,
-    centre: DVec3,
-    source_normal: DVec3,
-    area: f64,
-) -> f64 {
-    let d = centre - x;
-    let h = -source_normal.dot(d);
-    let a = n.dot(d);
-    if h <= 0.0 || a <= 0.0 {
-        return 0.0;
-    }
-    let r2 = d.length_squared();
-    let rho = d + h * source_normal;
-    let b = n - n.dot(source_normal) * source_normal;
-    let r4 = r2 * r2;
-    let kernel = a / r4;
-    let laplacian = (a * (16.0 * rho.length_squared() - 8.0 * h * h) / r4 - 8.0 * b.dot(rho) / r2) / r4;
-    (area * h / std::f64::consts::PI * (kernel + area / 24.0 * laplacian)).max(0.0)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -305,48 +264,6 @@ mod far_field_tests {
             }
             // Measured: 0.23, 0.070, 0.018, i.e. about 1.1 / ratio.
             assert!(worst < 1.5 / ratio, "ratio {ratio}: {worst}");
-        }
-    }
-
-    #[test]
-    fn second_order_far_field_error_shrinks_faster() {
-        // The same random squares as above: the second-order approximation's worst
-        // relative error must fall like (area / r^2)^2.
-        let mut rng = Pcg32::new(3, 4);
-        let mut random_unit = || {
-            let z = 2.0 * rng.uniform_f64() - 1.0;
-            let phi = std::f64::consts::TAU * rng.uniform_f64();
-            let r = (1.0 - z * z).sqrt();
-            DVec3::new(r * phi.cos(), r * phi.sin(), z)
-        };
-        for ratio in [4.0f64, 16.0, 64.0] {
-            let distance = ratio.sqrt();
-            let mut worst = 0.0f64;
-            for _ in 0..2000 {
-                let direction = random_unit();
-                let mut normal = random_unit();
-                if normal.dot(-direction) < 0.0 {
-                    normal = -normal;
-                }
-                let receiver_normal = random_unit();
-                if normal.dot(-direction) < 0.2 || receiver_normal.dot(direction) < 0.2 {
-                    continue;
-                }
-                let centre = direction * distance;
-                let (s, t) = crate::radiosity::patch::tangent_frame(normal);
-                let square = [
-                    centre - 0.5 * s - 0.5 * t,
-                    centre + 0.5 * s - 0.5 * t,
-                    centre + 0.5 * s + 0.5 * t,
-                    centre - 0.5 * s + 0.5 * t,
-                ];
-                let exact = point_polygon_factor(DVec3::ZERO, receiver_normal, &square, normal);
-                let approx =
-                    point_patch_far_field(DVec3::ZERO, receiver_normal, centre, normal, 1.0);
-                worst = worst.max((approx / exact - 1.0).abs());
-            }
-            // Measured: 0.035, 0.0016, 0.00011, i.e. about 0.5 / ratio^2.
-            assert!(worst < 0.6 / (ratio * ratio), "ratio {ratio}: {worst}");
         }
     }
 }

@@ -13,7 +13,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::contour::{point_patch_far_field, point_polygon_factor};
+use super::contour::{point_disk_approximation, point_polygon_factor};
 use super::matrix::FormFactorMatrix;
 use super::patch::{PatchSet, Polygon};
 use super::quadrature::{PatchRule, Rule1D};
@@ -184,7 +184,7 @@ impl RayCaster {
                 > ratio * target_patch.area
         });
         let f = if far {
-            point_patch_far_field(
+            point_disk_approximation(
                 x,
                 n,
                 target_patch.centroid,

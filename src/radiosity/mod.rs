@@ -10,6 +10,8 @@
 //! - [`visibility`]: the pluggable occlusion query (the renderer's BVH goes here).
 //! - [`solver`]: Jacobi and Gauss-Seidel on a stored matrix.
 //! - [`progressive`]: progressive refinement (shooting) with no N^2 storage.
+//! - [`contact`], [`refine`], [`adaptive`]: grading towards contact lines, conforming
+//!   red-green splits, and the solve-split-solve loop driven by neighbour contrast.
 //! - [`report`]: reciprocity, closure, irradiance and energy balance.
 //! - [`shapes`]: meshed boxes and spheres for tests and benchmarks.
 

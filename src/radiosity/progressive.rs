@@ -435,7 +435,9 @@ fn add_scaled(sum: &mut [f64; 3], value: &[f64; 3], scale: f64) {
 #[inline]
 fn selection_score(area: f64, unshot: &[f64; 3], selection: ShooterSelection) -> f64 {
     match selection {
-        ShooterSelection::TotalPower => area * (unshot[0].abs() + unshot[1].abs() + unshot[2].abs()),
+        ShooterSelection::TotalPower => {
+            area * (unshot[0].abs() + unshot[1].abs() + unshot[2].abs())
+        }
         ShooterSelection::Band(b) => area * unshot[b].abs(),
     }
 }

@@ -257,7 +257,12 @@ impl Refinement {
     /// on the same side that contains its centroid, found among the pieces of the old
     /// leaf its cell descends from (the nearest such piece when rounding puts the
     /// centroid on no piece). A starting guess for solving the new mesh.
-    pub fn carry(&self, old: &RefinedScene, values: &[[f64; 3]], new: &RefinedScene) -> Vec<[f64; 3]> {
+    pub fn carry(
+        &self,
+        old: &RefinedScene,
+        values: &[[f64; 3]],
+        new: &RefinedScene,
+    ) -> Vec<[f64; 3]> {
         let mut pieces: HashMap<u32, Vec<u32>> = HashMap::new();
         for (i, &c) in old.patch_cell.iter().enumerate() {
             pieces.entry(c).or_default().push(i as u32);
@@ -285,14 +290,16 @@ impl Refinement {
                     })
                 });
                 let nearest = || {
-                    same_side
-                        .clone()
-                        .min_by(|&a, &b| {
-                            let d = |j: u32| (old_set.patches[j as usize].centroid - patch.centroid).length_squared();
-                            d(a).total_cmp(&d(b))
-                        })
+                    same_side.clone().min_by(|&a, &b| {
+                        let d = |j: u32| {
+                            (old_set.patches[j as usize].centroid - patch.centroid).length_squared()
+                        };
+                        d(a).total_cmp(&d(b))
+                    })
                 };
-                containing.or_else(nearest).map_or([0.0; 3], |j| values[j as usize])
+                containing
+                    .or_else(nearest)
+                    .map_or([0.0; 3], |j| values[j as usize])
             })
             .collect()
     }
@@ -365,7 +372,9 @@ impl Refinement {
         if dropped > 0 {
             scene.warnings.push(crate::scene::Warning {
                 loc: crate::scene::FileLoc::builtin("radiosity refinement"),
-                message: format!("radiosity: {dropped} degenerate element(s) dropped while refining"),
+                message: format!(
+                    "radiosity: {dropped} degenerate element(s) dropped while refining"
+                ),
             });
         }
         RefinedScene { scene, patch_cell }
@@ -376,9 +385,7 @@ impl Refinement {
     fn closure(&self, cell: &Cell) -> Vec<([u32; 4], usize)> {
         let k = cell.count as usize;
         let c = cell.corners;
-        let mids: Vec<Option<u32>> = (0..k)
-            .map(|e| self.hanging(c[e], c[(e + 1) % k]))
-            .collect();
+        let mids: Vec<Option<u32>> = (0..k).map(|e| self.hanging(c[e], c[(e + 1) % k])).collect();
         let hanging: Vec<usize> = (0..k).filter(|&e| mids[e].is_some()).collect();
         let tri = |a: u32, b: u32, d: u32| ([a, b, d, 0], 3);
         match (k, hanging.as_slice()) {

@@ -14,10 +14,10 @@ use std::sync::atomic::Ordering;
 
 use glam::{DVec3, Vec3};
 
+use super::adaptive::{AdaptiveSolution, solve_adaptive};
 use super::display::{DisplayMesh, PatchTracer};
 use super::scene::RadiosityScene;
 use super::settings::{RadiositySettings, VisibilitySource};
-use super::adaptive::{AdaptiveSolution, solve_adaptive};
 use super::solve::{RadiosityStats, SolveEvent};
 use super::world_visibility::{FaceVisibility, SceneVisibility, WorldVisibility};
 use crate::color::Rgb;

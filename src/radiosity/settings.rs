@@ -241,7 +241,7 @@ impl RadiositySettings {
         // Example: `"float refinethreshold" [0.05]`.
         let refine_threshold =
             params.finite_float("refinethreshold", defaults.refine_threshold as f32)? as f64;
-        if !(refine_threshold > 0.0) {
+        if refine_threshold <= 0.0 {
             return Err(bad(
                 "refinethreshold",
                 format!("must be positive, got {refine_threshold}"),

@@ -93,7 +93,8 @@ fn refined_meshes_stay_conforming_and_cover_the_same_surfaces() {
                 let c = polygon.as_slice();
                 (0..c.len())
                     .map(|k| {
-                        let (a, b, d) = (c[k], c[(k + 1) % c.len()], c[(k + c.len() - 1) % c.len()]);
+                        let (a, b, d) =
+                            (c[k], c[(k + 1) % c.len()], c[(k + c.len() - 1) % c.len()]);
                         (b - a).angle_between(d - a)
                     })
                     .fold(f64::MAX, f64::min)
@@ -108,7 +109,7 @@ fn refined_meshes_stay_conforming_and_cover_the_same_surfaces() {
         let cells: Vec<u32> = refined.patch_cell[..refined.scene.front_count]
             .iter()
             .copied()
-            .filter(|&c| hash_u64s(&[round, c as u64]) % 3 == 0)
+            .filter(|&c| hash_u64s(&[round, c as u64]).is_multiple_of(3))
             .collect();
         assert!(forest.split(&cells, 8) > 0);
         refined = forest.scene();
@@ -123,7 +124,10 @@ fn refined_meshes_stay_conforming_and_cover_the_same_surfaces() {
             let t = scene.twin[i];
             if t != NO_TWIN {
                 assert_eq!(scene.twin[t as usize], i as u32);
-                let (f, b) = (&scene.patches.patches[i], &scene.patches.patches[t as usize]);
+                let (f, b) = (
+                    &scene.patches.patches[i],
+                    &scene.patches.patches[t as usize],
+                );
                 assert!((f.area - b.area).abs() < 1e-9 * f.area);
                 assert!((f.normal + b.normal).length() < 1e-9);
             }
@@ -174,7 +178,10 @@ fn contact_grading_refines_towards_the_blocks_bases_only() {
     let ceiling = smallest_near(&|p: DVec3| p.y > 548.0);
     assert!(ceiling > 0.6 * base_edge, "{ceiling} vs {base_edge}");
     let floor_corner = smallest_near(&|p: DVec3| p.y < 1e-3 && p.x < 40.0 && p.z > 520.0);
-    assert!(floor_corner > 0.6 * base_edge, "{floor_corner} vs {base_edge}");
+    assert!(
+        floor_corner > 0.6 * base_edge,
+        "{floor_corner} vs {base_edge}"
+    );
 }
 
 #[test]
@@ -221,7 +228,11 @@ fn contrast_marks_follow_the_shadow_edges() {
         c.y < 1e-3 && (c - DVec3::new(186.0, 0.0, 169.0)).length() < 40.0
     });
     assert!(hidden.clone().count() > 0);
-    assert!(hidden.clone().all(|i| !marks[i] && solution.irradiance[i] == [0.0; 3]));
+    assert!(
+        hidden
+            .clone()
+            .all(|i| !marks[i] && solution.irradiance[i] == [0.0; 3])
+    );
 }
 
 #[test]
@@ -250,7 +261,11 @@ fn refined_render_runs_through_the_session() {
     let IntegratorStats::Radiosity(stats) = out.stats else {
         panic!("not radiosity")
     };
-    assert!(stats.patches > unrefined, "{} vs {unrefined}", stats.patches);
+    assert!(
+        stats.patches > unrefined,
+        "{} vs {unrefined}",
+        stats.patches
+    );
     assert!(stats.converged);
     let imbalance = stats.balance.imbalance();
     assert!(
@@ -277,4 +292,75 @@ fn refined_render_runs_through_the_session() {
     )
     .unwrap();
     assert!(solved.scene.is_none() && solved.passes == 0);
+}
+
+#[test]
+fn a_primed_solve_reaches_the_cold_solution() {
+    // Progressive refinement from a starting guess (what a refinement pass carries
+    // over from the coarser mesh) converges to the same radiosities as a cold start,
+    // from a guess that is too bright (negative unshot radiosity) as from one too
+    // dark, and keeps every watt booked.
+    use radiant::radiosity::solve::solve_from;
+    let scene = cornell(4000.0, false);
+    let vis = FaceVisibility::new(&scene);
+    let (world, _) = World::build(&cornell_box()).unwrap();
+    let settings = RadiositySettings {
+        max_patch_area: Some(4000.0),
+        tolerance: 1e-7,
+        ..RadiositySettings::default()
+    };
+    let solve_with = |guess: Option<&[[f64; 3]]>| {
+        solve_from(
+            &scene,
+            &world.lights,
+            world.scene_sphere(),
+            &settings,
+            &vis,
+            guess,
+            |_| ControlFlow::Continue(()),
+        )
+        .unwrap()
+    };
+    let cold = solve_with(None);
+    assert!(cold.converged);
+    let scale =
+        |s: f64| -> Vec<[f64; 3]> { cold.radiosity.iter().map(|b| b.map(|v| s * v)).collect() };
+    let mean_b: f64 = cold
+        .radiosity
+        .iter()
+        .map(|b| b[0] + b[1] + b[2])
+        .sum::<f64>()
+        / (3 * cold.radiosity.len()) as f64;
+    for s in [0.8, 1.25] {
+        let guess = scale(s);
+        let primed = solve_with(Some(&guess));
+        assert!(primed.converged);
+        let worst = primed
+            .radiosity
+            .iter()
+            .zip(&cold.radiosity)
+            .flat_map(|(a, b)| (0..3).map(move |k| (a[k] - b[k]).abs()))
+            .fold(0.0, f64::max);
+        // Both stop at 1e-7 of the emitted power unshot.
+        assert!(
+            worst < 1e-5 * mean_b,
+            "guess x{s}: {worst} vs mean {mean_b}"
+        );
+        let imbalance = primed.balance.imbalance();
+        assert!(
+            (0..3).all(|b| imbalance[b].abs() < 1e-9 * primed.balance.emitted[b]),
+            "{imbalance:?}"
+        );
+    }
+    // The exact solution as the guess: its priming shots alone leave (almost) nothing
+    // to shoot.
+    let exact = solve_with(Some(&cold.radiosity));
+    assert!(exact.converged);
+    assert!(
+        exact.iterations <= scene.patches.len() + 10,
+        "{} shots for {} patches (cold: {})",
+        exact.iterations,
+        scene.patches.len(),
+        cold.iterations
+    );
 }

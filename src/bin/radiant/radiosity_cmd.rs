@@ -11,9 +11,9 @@ use std::sync::atomic::Ordering;
 use anyhow::{Context, bail};
 use clap::Args;
 use radiant::image::{ImageMeta, write_image};
+use radiant::radiosity::adaptive::solve_adaptive;
 use radiant::radiosity::export::{LitMesh, write_lit_mesh, write_patch_csv, write_ply};
 use radiant::radiosity::render::{Shading, scene_visibility};
-use radiant::radiosity::adaptive::solve_adaptive;
 use radiant::radiosity::solve::SolveEvent;
 use radiant::render::integrator::Integrator;
 use radiant::render::{Overrides, Progress, Session};
@@ -250,8 +250,13 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
                         SolveEvent::Sweep { .. } => 900,
                     };
                     progress.done.store(done, Ordering::Relaxed);
-                    if let (SolveEvent::Shot { scene: mesh, state, .. }, Some(every), Some(pattern)) =
-                        (&event, args.every, &args.sequence)
+                    if let (
+                        SolveEvent::Shot {
+                            scene: mesh, state, ..
+                        },
+                        Some(every),
+                        Some(pattern),
+                    ) = (&event, args.every, &args.sequence)
                         && every > 0
                         && state.shots.is_multiple_of(every)
                         && frame_error.is_none()
