@@ -8,6 +8,7 @@ mod enclosures;
 mod export;
 mod formfactors;
 mod hemicube;
+mod mesh_checks;
 mod meshes;
 mod pipeline;
 mod refinement;

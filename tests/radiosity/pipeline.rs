@@ -4,7 +4,6 @@
 use std::ops::ControlFlow;
 
 use radiant::math::{DVec3, Vec3};
-use radiant::radiosity::display::DisplayMesh;
 use radiant::radiosity::scene::RadiosityScene;
 use radiant::radiosity::settings::{FormFactorMethod, RadiositySettings, SolverKind};
 use radiant::radiosity::solve::{Solution, solve};
@@ -13,6 +12,8 @@ use radiant::radiosity::{Visibility, settings};
 use radiant::render::world::World;
 use radiant::scene::builtin::cornell_box;
 use radiant::scene::{FileLoc, Geometry, LightDesc, MaterialDesc, SceneDesc, ShapeDesc};
+
+use crate::mesh_checks::assert_conforming;
 
 fn settings_with_area(area: f64) -> RadiositySettings {
     RadiositySettings {
@@ -54,53 +55,11 @@ fn max_relative_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
         / scale
 }
 
-/// Distance from `p` to the segment `a b`.
-fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
-    (a + t * (b - a) - p).length()
-}
-
 #[test]
 fn cornell_mesh_is_conforming_within_every_surface() {
-    // Edges of display vertices (one per point and surface) used by a single patch
-    // must lie on an input face's boundary: an edge inside a face used once would be a
-    // T-junction (a neighbour with a vertex in the middle of it).
+    // No T-junctions (see `assert_conforming`).
     let (_, scene, _) = cornell(2000.0);
-    let mesh = DisplayMesh::new(&scene);
-    let mut uses = std::collections::HashMap::new();
-    for (p, c) in scene.patches.patches.iter().zip(&mesh.corner_vertex) {
-        let n = p.corner_count as usize;
-        for k in 0..n {
-            *uses.entry((c[k], c[(k + 1) % n])).or_insert(0) += 1;
-        }
-    }
-    let face_edges: Vec<(DVec3, DVec3)> = scene
-        .faces
-        .faces
-        .iter()
-        .flat_map(|f| {
-            let n = f.count as usize;
-            (0..n).map(move |k| (f.corners[k], f.corners[(k + 1) % n]))
-        })
-        .map(|(a, b)| {
-            (
-                scene.faces.points[a as usize],
-                scene.faces.points[b as usize],
-            )
-        })
-        .collect();
-    let mut boundary = 0;
-    for &(a, b) in uses.keys() {
-        if uses.contains_key(&(b, a)) {
-            continue;
-        }
-        boundary += 1;
-        let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
-        let on_input_edge = face_edges
-            .iter()
-            .any(|&(u, v)| segment_distance(pa, u, v) < 1e-9 && segment_distance(pb, u, v) < 1e-9);
-        assert!(on_input_edge, "edge {pa} - {pb} is open inside a face");
-    }
+    let (boundary, mesh) = assert_conforming(&scene);
     assert!(boundary > 0);
     // The back-right-bottom corner (floor, back wall, green wall) has three display
     // vertices: the three surfaces meet there but are not blended.

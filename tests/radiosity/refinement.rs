@@ -2,19 +2,19 @@
 //! contact grading finds the contact lines, and a refined render runs through the
 //! integrator and the session.
 
-use std::collections::HashMap;
 use std::ops::ControlFlow;
 
 use radiant::math::DVec3;
 use radiant::math::hash::hash_u64s;
 use radiant::radiosity::adaptive::{contrast_marks, solve_adaptive};
-use radiant::radiosity::display::DisplayMesh;
 use radiant::radiosity::refine::Refinement;
 use radiant::radiosity::scene::{NO_TWIN, RadiosityScene};
 use radiant::radiosity::settings::RadiositySettings;
 use radiant::radiosity::world_visibility::FaceVisibility;
 use radiant::render::world::World;
 use radiant::scene::builtin::cornell_box;
+
+use crate::mesh_checks::{assert_conforming, segment_distance};
 
 fn cornell(area: f64, two_sided: bool) -> RadiosityScene {
     let settings = RadiositySettings {
@@ -23,54 +23,6 @@ fn cornell(area: f64, two_sided: bool) -> RadiosityScene {
         ..RadiositySettings::default()
     };
     RadiosityScene::from_desc(&cornell_box(), &settings).unwrap()
-}
-
-fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
-    (a + t * (b - a) - p).length()
-}
-
-/// Edges of display vertices used by a single patch must lie on an input face's
-/// boundary: one inside a face would be a T-junction. Returns the number of such
-/// boundary edges.
-fn assert_conforming(scene: &RadiosityScene) -> usize {
-    let mesh = DisplayMesh::new(scene);
-    let mut uses = HashMap::new();
-    for (p, c) in scene.patches.patches.iter().zip(&mesh.corner_vertex) {
-        let n = p.corner_count as usize;
-        for k in 0..n {
-            *uses.entry((c[k], c[(k + 1) % n])).or_insert(0) += 1;
-        }
-    }
-    let face_edges: Vec<(DVec3, DVec3)> = scene
-        .faces
-        .faces
-        .iter()
-        .flat_map(|f| {
-            let n = f.count as usize;
-            (0..n).map(move |k| (f.corners[k], f.corners[(k + 1) % n]))
-        })
-        .map(|(a, b)| {
-            (
-                scene.faces.points[a as usize],
-                scene.faces.points[b as usize],
-            )
-        })
-        .collect();
-    let mut boundary = 0;
-    for (&(a, b), &count) in &uses {
-        assert_eq!(count, 1, "edge used {count} times the same way");
-        if uses.contains_key(&(b, a)) {
-            continue;
-        }
-        boundary += 1;
-        let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
-        let on_input_edge = face_edges
-            .iter()
-            .any(|&(u, v)| segment_distance(pa, u, v) < 1e-9 && segment_distance(pb, u, v) < 1e-9);
-        assert!(on_input_edge, "edge {pa} - {pb} is open inside a face");
-    }
-    boundary
 }
 
 #[test]
@@ -85,7 +37,7 @@ fn refined_meshes_stay_conforming_and_cover_the_same_surfaces() {
     // allowed 0.35 of the base's).
     let base = cornell(4000.0, true);
     let area = base.patches.total_area();
-    let base_boundary = assert_conforming(&base);
+    let base_boundary = assert_conforming(&base).0;
     let smallest_angle = |scene: &RadiosityScene| {
         (0..scene.patches.len())
             .map(|i| {
@@ -135,7 +87,7 @@ fn refined_meshes_stay_conforming_and_cover_the_same_surfaces() {
         assert_eq!(scene.patch_face.len(), scene.patches.len());
         // Refining never opens the input boundary further: the open edges are the
         // input's boundary cut at the new points.
-        assert!(assert_conforming(scene) >= base_boundary);
+        assert!(assert_conforming(scene).0 >= base_boundary);
         let angle = smallest_angle(scene);
         assert!(
             angle > 0.35 * base_angle,
