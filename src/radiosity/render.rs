@@ -18,7 +18,7 @@ use super::adaptive::{AdaptiveSolution, solve_adaptive};
 use super::display::{DisplayMesh, PatchTracer};
 use super::scene::RadiosityScene;
 use super::settings::{RadiositySettings, VisibilitySource};
-use super::solve::{RadiosityStats, SolveEvent};
+use super::solve::{RadiosityError, RadiosityStats, SolveEvent};
 use super::world_visibility::{FaceVisibility, SceneVisibility, WorldVisibility};
 use crate::color::Rgb;
 use crate::image::Image;
@@ -283,6 +283,21 @@ pub fn solve_session(
     settings: &RadiositySettings,
     progress: &Progress,
 ) -> AdaptiveSolution {
+    solve_session_observed(session, scene, settings, progress, |_| {})
+        // Settings were validated when the session was built (hemi-cube resolution) and
+        // the patch set and its solver inputs come from one scene, so no error can remain.
+        .expect("radiosity inputs are consistent")
+}
+
+/// [`solve_session`], showing every solver event to `observe` as well (the CLI writes
+/// the progressive sequence from it).
+pub fn solve_session_observed(
+    session: &Session,
+    scene: &RadiosityScene,
+    settings: &RadiositySettings,
+    progress: &Progress,
+    mut observe: impl FnMut(&SolveEvent<'_>),
+) -> Result<AdaptiveSolution, RadiosityError> {
     progress.total.store(1000, Ordering::Relaxed);
     progress.done.store(0, Ordering::Relaxed);
     let sphere = session.world.scene_sphere();
@@ -299,6 +314,7 @@ pub fn solve_session(
                 SolveEvent::Sweep { .. } => 900,
             };
             progress.done.store(done, Ordering::Relaxed);
+            observe(&event);
             if progress.cancelled() {
                 ControlFlow::Break(())
             } else {
@@ -306,9 +322,6 @@ pub fn solve_session(
             }
         },
     )
-    // Settings were validated when the session was built (hemi-cube resolution) and
-    // the patch set and its solver inputs come from one scene, so no error can remain.
-    .expect("radiosity inputs are consistent")
 }
 
 /// The radiosity integrator's render: solve, then the image (`snapshot` sees it at

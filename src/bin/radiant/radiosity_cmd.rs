@@ -3,7 +3,6 @@
 //! progressive-refinement sequence.
 
 use std::io::IsTerminal;
-use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
@@ -11,9 +10,8 @@ use std::sync::atomic::Ordering;
 use anyhow::{Context, bail};
 use clap::Args;
 use radiant::image::{ImageMeta, write_image};
-use radiant::radiosity::adaptive::solve_adaptive;
 use radiant::radiosity::export::{LitMesh, write_lit_mesh, write_patch_csv, write_ply};
-use radiant::radiosity::render::{Shading, scene_visibility};
+use radiant::radiosity::render::{Shading, solve_session_observed};
 use radiant::radiosity::solve::SolveEvent;
 use radiant::render::integrator::Integrator;
 use radiant::render::{Overrides, Progress, Session};
@@ -233,57 +231,36 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
             let bar_done = Arc::clone(&bar_done);
             s.spawn(move || draw_progress(&progress, &bar_done));
         }
-        progress.total.store(1000, Ordering::Relaxed);
         let solved = pool.install(|| {
-            solve_adaptive(
-                scene,
-                &session.world.lights,
-                session.world.scene_sphere(),
-                settings,
-                |mesh| scene_visibility(mesh, &session.world, settings),
-                |event| {
-                    let done = match &event {
-                        SolveEvent::Shot { fraction_done, .. } => (1000.0 * fraction_done) as u64,
-                        SolveEvent::Factors { done, total } => {
-                            (900 * done / (*total).max(1)) as u64
-                        }
-                        SolveEvent::Sweep { .. } => 900,
-                    };
-                    progress.done.store(done, Ordering::Relaxed);
-                    if let (
-                        SolveEvent::Shot {
-                            scene: mesh, state, ..
-                        },
-                        Some(every),
-                        Some(pattern),
-                    ) = (&event, args.every, &args.sequence)
-                        && every > 0
-                        && state.shots.is_multiple_of(every)
-                        && frame_error.is_none()
-                    {
-                        let display = state.display_radiosity(&mesh.patches);
-                        let shading =
-                            Shading::new(mesh, &session.world, &display, &state.irradiance, 0)
-                                .with_specular_depth(settings.max_depth);
-                        let frame_progress = Progress::default();
-                        let out = session.render_shading(&shading, &frame_progress, &mut |_, _| {});
-                        let path = frame_path(pattern, state.shots / every);
-                        if let Err(e) = write_image(
-                            &path,
-                            &out.film.image(),
-                            &meta(out.spp_done, out.seconds),
-                            args.exposure,
-                        ) {
-                            frame_error = Some(anyhow::anyhow!("writing {}: {e}", path.display()));
-                        }
+            solve_session_observed(&session, scene, settings, &progress, |event| {
+                if let (
+                    SolveEvent::Shot {
+                        scene: mesh, state, ..
+                    },
+                    Some(every),
+                    Some(pattern),
+                ) = (event, args.every, &args.sequence)
+                    && every > 0
+                    && state.shots.is_multiple_of(every)
+                    && frame_error.is_none()
+                {
+                    let display = state.display_radiosity(&mesh.patches);
+                    let shading =
+                        Shading::new(mesh, &session.world, &display, &state.irradiance, 0)
+                            .with_specular_depth(settings.max_depth);
+                    let frame_progress = Progress::default();
+                    let out = session.render_shading(&shading, &frame_progress, &mut |_, _| {});
+                    let path = frame_path(pattern, state.shots / every);
+                    if let Err(e) = write_image(
+                        &path,
+                        &out.film.image(),
+                        &meta(out.spp_done, out.seconds),
+                        args.exposure,
+                    ) {
+                        frame_error = Some(anyhow::anyhow!("writing {}: {e}", path.display()));
                     }
-                    if progress.cancelled() {
-                        ControlFlow::Break(())
-                    } else {
-                        ControlFlow::Continue(())
-                    }
-                },
-            )
+                }
+            })
         });
         bar_done.store(true, Ordering::SeqCst);
         solved
