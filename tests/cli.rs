@@ -165,3 +165,57 @@ fn interrupt_writes_the_partial_image() {
     let img = read_image(&path).unwrap();
     assert!(img.mean() > 0.0, "partial image is empty");
 }
+
+/// `radiant radiosity --every K --sequence PATTERN` writes the classic progressive
+/// sequence: one numbered image per K shots, approaching the final image; `--every`
+/// alone is refused.
+#[test]
+fn radiosity_writes_the_progressive_sequence() {
+    let dir = temp_dir("radiosity-sequence");
+    let final_path = dir.join("final.pfm");
+    let out = run(radiant()
+        .args([
+            "radiosity",
+            "cornell-box",
+            "--tolerance",
+            "0.01",
+            "--resolution",
+            "16x16",
+            "--spp",
+            "4",
+            "--every",
+            "200",
+            "--quiet",
+            "--sequence",
+        ])
+        .arg(dir.join("frame-####.pfm"))
+        .arg("-o")
+        .arg(&final_path));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let frames: Vec<_> = (1..)
+        .map(|k| dir.join(format!("frame-{k:04}.pfm")))
+        .take_while(|p| p.exists())
+        .map(|p| read_image(&p).unwrap())
+        .collect();
+    assert!(frames.len() >= 2, "{} frames", frames.len());
+    let final_mean = read_image(&final_path).unwrap().mean();
+    assert!(final_mean > 0.0);
+    // Each frame shows B plus the ambient estimate of what is still unshot, so the
+    // frames close in on the solution as the unshot power falls.
+    let first = (frames[0].mean() / final_mean - 1.0).abs();
+    let last = (frames[frames.len() - 1].mean() / final_mean - 1.0).abs();
+    assert!(
+        frames
+            .iter()
+            .all(|f| f.pixels.iter().all(|p| p.is_finite()))
+    );
+    assert!(last < first, "first frame off by {first}, last by {last}");
+
+    let out = run(radiant().args(["radiosity", "cornell-box", "--every", "10", "--quiet"]));
+    let stderr = assert_clean_failure(&out, "--every without --sequence");
+    assert!(stderr.contains("--sequence"), "{stderr}");
+}
