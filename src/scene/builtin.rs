@@ -58,26 +58,7 @@ fn quad(vs: [Vec3; 4], material: MaterialId, scene: &str) -> ShapeDesc {
 }
 
 fn quads(list: &[[Vec3; 4]], material: MaterialId, scene: &str) -> ShapeDesc {
-    let mut positions = Vec::new();
-    let mut indices = Vec::new();
-    for q in list {
-        let base = positions.len() as u32;
-        positions.extend_from_slice(q);
-        indices.extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
-    }
-    ShapeDesc {
-        geometry: Geometry::TriangleMesh {
-            positions,
-            indices,
-            normals: None,
-            uvs: None,
-        },
-        render_from_object: Transform::IDENTITY,
-        reverse_orientation: false,
-        material,
-        area_light: None,
-        loc: loc(scene),
-    }
+    ShapeDesc::quads(list, material, loc(scene))
 }
 
 fn sphere(center: Vec3, radius: f32, material: MaterialId, scene: &str) -> ShapeDesc {

@@ -213,6 +213,33 @@ pub struct ShapeDesc {
     pub loc: FileLoc,
 }
 
+impl ShapeDesc {
+    /// Planar quads `(v0, v1, v2, v3)` as one triangle mesh of the triangles
+    /// `(v0, v1, v2)`, `(v0, v2, v3)` each, in render space, not emitting.
+    pub fn quads(list: &[[Vec3; 4]], material: MaterialId, loc: FileLoc) -> ShapeDesc {
+        let mut positions = Vec::with_capacity(4 * list.len());
+        let mut indices = Vec::with_capacity(6 * list.len());
+        for q in list {
+            let base = positions.len() as u32;
+            positions.extend_from_slice(q);
+            indices.extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+        }
+        ShapeDesc {
+            geometry: Geometry::TriangleMesh {
+                positions,
+                indices,
+                normals: None,
+                uvs: None,
+            },
+            render_from_object: Transform::IDENTITY,
+            reverse_orientation: false,
+            material,
+            area_light: None,
+            loc,
+        }
+    }
+}
+
 /// `ObjectBegin "name"` … `ObjectEnd`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ObjectDesc {
