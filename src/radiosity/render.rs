@@ -26,7 +26,7 @@ use crate::math::{Frame, sampling};
 use crate::render::geometry::Ray;
 use crate::render::geometry::ray::offset_origin;
 use crate::render::integrator::IntegratorStats;
-use crate::render::material::TransportMode;
+use crate::render::integrator::specular::specular_bounce;
 use crate::render::sampler::PixelSample;
 use crate::render::session::{Progress, RenderOutput, Session};
 use crate::render::world::World;
@@ -156,19 +156,10 @@ impl<'a> Shading<'a> {
                 let n = self.shading_normal(hit.struck, &hit.weights_struck);
                 let frame = Frame::from_normal(n);
                 let wo = frame.to_local(-ray.d.normalize());
-                let Some(bs) = struck_material.sample(
-                    wo,
-                    sampler.get_1d(),
-                    sampler.get_2d(),
-                    TransportMode::Radiance,
-                ) else {
+                let Some(wi) = specular_bounce(&struck_material, &frame, wo, sampler, &mut beta)
+                else {
                     break;
                 };
-                beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-                if beta.is_black() {
-                    break;
-                }
-                let wi = frame.to_world(bs.wi);
                 let ng = self.scene.patches.patches[hit.struck].normal.as_vec3();
                 ray = Ray::new(offset_origin(hit.p.as_vec3(), ng, wi), wi);
                 continue;

@@ -6,6 +6,7 @@ pub mod direct;
 pub mod footprint;
 pub mod path;
 pub mod photon;
+pub mod specular;
 pub mod sppm;
 
 pub use path::PathSettings;

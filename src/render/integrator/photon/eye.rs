@@ -13,6 +13,7 @@ use crate::color::Rgb;
 use crate::math::{Frame, INV_PI};
 use crate::render::geometry::Ray;
 use crate::render::integrator::direct::{environment, sample_direct, surface_emission};
+use crate::render::integrator::specular::specular_bounce;
 use crate::render::light::SceneSphere;
 use crate::render::material::{Material, TransportMode};
 use crate::render::sampler::PixelSample;
@@ -88,21 +89,11 @@ pub fn radiance(
                 break;
             }
             let frame = Frame::from_normal(hit.ns);
-            let u_lobe = sampler.get_1d();
-            let u_dir = sampler.get_2d();
-            let Some(bs) = material.sample(
-                frame.to_local(wo_world),
-                u_lobe,
-                u_dir,
-                TransportMode::Radiance,
-            ) else {
+            let wo = frame.to_local(wo_world);
+            let Some(wi) = specular_bounce(&material, &frame, wo, sampler, &mut beta) else {
                 break;
             };
-            beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-            if beta.is_black() {
-                break;
-            }
-            ray = hit.spawn_ray(frame.to_world(bs.wi));
+            ray = hit.spawn_ray(wi);
             continue;
         }
         let at = EstimatePoint {
@@ -256,13 +247,10 @@ fn final_gather(
             let frame_y = Frame::from_normal(y.ns);
             let wo_y = frame_y.to_local(wo_y_world);
             if mat_y.is_specular() {
-                let u_lobe = s.get_1d();
-                let u_dir = s.get_2d();
-                let Some(bs) = mat_y.sample(wo_y, u_lobe, u_dir, TransportMode::Radiance) else {
+                let Some(wi) = specular_bounce(&mat_y, &frame_y, wo_y, &mut s, &mut beta) else {
                     break;
                 };
-                beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-                ray = y.spawn_ray(frame_y.to_world(bs.wi));
+                ray = y.spawn_ray(wi);
                 continue;
             }
             let u_choice = s.get_1d();

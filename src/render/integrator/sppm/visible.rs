@@ -14,7 +14,7 @@ use crate::color::Rgb;
 use crate::math::Frame;
 use crate::render::Session;
 use crate::render::integrator::direct::{environment, sample_direct, surface_emission};
-use crate::render::material::TransportMode;
+use crate::render::integrator::specular::specular_bounce;
 use crate::render::sampler::PixelSample;
 
 /// A camera path's first diffuse point this iteration.
@@ -78,16 +78,10 @@ pub fn camera_sample(
             if depth == max_depth {
                 break;
             }
-            let u_lobe = sampler.get_1d();
-            let u_dir = sampler.get_2d();
-            let Some(bs) = material.sample(wo, u_lobe, u_dir, TransportMode::Radiance) else {
+            let Some(wi) = specular_bounce(&material, &frame, wo, &mut sampler, &mut beta) else {
                 break;
             };
-            beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-            if beta.is_black() {
-                break;
-            }
-            ray = hit.spawn_ray(frame.to_world(bs.wi));
+            ray = hit.spawn_ray(wi);
             continue;
         }
         let u_choice = sampler.get_1d();
