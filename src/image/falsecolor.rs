@@ -12,7 +12,7 @@
 
 use std::sync::OnceLock;
 
-use super::metrics::RELMSE_EPSILON;
+use super::metrics::{RELMSE_EPSILON, check_same_size};
 use super::{Image, ImageError};
 use crate::color::Rgb;
 
@@ -45,14 +45,7 @@ pub fn false_color_error(
     metric: ErrorMetric,
     scale: Option<f32>,
 ) -> Result<FalseColor, ImageError> {
-    if (test.width, test.height) != (reference.width, reference.height) {
-        return Err(ImageError::SizeMismatch {
-            test_w: test.width,
-            test_h: test.height,
-            ref_w: reference.width,
-            ref_h: reference.height,
-        });
-    }
+    check_same_size(test, reference)?;
     let errors: Vec<Option<f32>> = test
         .pixels
         .iter()

@@ -31,16 +31,22 @@ pub struct Metrics {
     pub count: usize,
 }
 
+/// `SizeMismatch` unless `test` and `reference` have the same size.
+pub fn check_same_size(test: &Image, reference: &Image) -> Result<(), ImageError> {
+    if (test.width, test.height) == (reference.width, reference.height) {
+        return Ok(());
+    }
+    Err(ImageError::SizeMismatch {
+        test_w: test.width,
+        test_h: test.height,
+        ref_w: reference.width,
+        ref_h: reference.height,
+    })
+}
+
 /// Compares `test` against `reference` inside `crop` (the whole image when `None`).
 pub fn compare(test: &Image, reference: &Image, crop: Option<Crop>) -> Result<Metrics, ImageError> {
-    if (test.width, test.height) != (reference.width, reference.height) {
-        return Err(ImageError::SizeMismatch {
-            test_w: test.width,
-            test_h: test.height,
-            ref_w: reference.width,
-            ref_h: reference.height,
-        });
-    }
+    check_same_size(test, reference)?;
     let crop = crop.unwrap_or(Crop::full(test.width, test.height));
     crop.check(test.width, test.height)?;
 
