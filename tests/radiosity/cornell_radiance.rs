@@ -183,11 +183,11 @@ impl Solved {
     }
 }
 
-/// The floor's and then the back wall's sensors of the data's variant "brief".
-fn all_sensors(data: &Value) -> Vec<(DVec3, DVec3, [f64; 3])> {
-    let variant = &data["variants"]["brief"];
-    let mut all = sensors(&variant["floor"]);
-    all.extend(sensors(&variant["back_wall"]));
+/// The floor's and then the back wall's sensors of `grids` (the data's variant "brief",
+/// or [`converged_radiance`]).
+fn both_grids(grids: &Value) -> Vec<(DVec3, DVec3, [f64; 3])> {
+    let mut all = sensors(&grids["floor"]);
+    all.extend(sensors(&grids["back_wall"]));
     all
 }
 
@@ -323,11 +323,7 @@ fn radiance_discrepancy_is_shared_by_the_path_tracer() {
         max_depth: 100,
         rr_depth: 5,
     };
-    let converged = converged_radiance();
-    let converged: Vec<_> = ["floor", "back_wall"]
-        .iter()
-        .flat_map(|grid| sensors(&converged[*grid]))
-        .collect();
+    let converged = both_grids(&converged_radiance());
     let wanted = [
         [278.0, 24.945, 559.0],
         [227.45, 24.945, 559.0],
@@ -335,11 +331,15 @@ fn radiance_discrepancy_is_shared_by_the_path_tracer() {
         [278.0, 0.0, 533.59],
         [379.09, 0.0, 533.59],
     ];
-    for (p, n, reference) in all_sensors(data).into_iter().filter(|(p, _, _)| {
-        wanted
-            .iter()
-            .any(|w| (DVec3::from_array(*w) - *p).length() < 0.1)
-    }) {
+    for (p, n, reference) in
+        both_grids(&data["variants"]["brief"])
+            .into_iter()
+            .filter(|(p, _, _)| {
+                wanted
+                    .iter()
+                    .any(|w| (DVec3::from_array(*w) - *p).length() < 0.1)
+            })
+    {
         let x = p + 0.01 * n;
         let frame = radiant::math::Frame::from_normal(n.as_vec3());
         let count = 3_000_000u32;
@@ -517,13 +517,8 @@ fn radiance_departs_where_its_light_sampling_is_coarse() {
     let mut exact_radiance: Vec<[f64; 3]> = Vec::new();
     let mut coarse_radiance: Vec<[f64; 3]> = Vec::new();
     let mut exact_converged: Vec<[f64; 3]> = Vec::new();
-    let converged = converged_radiance();
-    let converged: Vec<[f64; 3]> = ["floor", "back_wall"]
-        .iter()
-        .flat_map(|grid| sensors(&converged[*grid]))
-        .map(|(_, _, e)| e)
-        .collect();
-    for (s, (p, n, reference)) in all_sensors(data).iter().enumerate() {
+    let converged = both_grids(&converged_radiance());
+    for (s, (p, n, reference)) in both_grids(&data["variants"]["brief"]).iter().enumerate() {
         let x = *p + 0.01 * *n;
         let exact_direct = grid_direct(x, *n, 128);
         let coarse_direct = grid_direct(x, *n, 8);
@@ -537,7 +532,7 @@ fn radiance_departs_where_its_light_sampling_is_coarse() {
         ours_exact.push(std::array::from_fn(|b| ours[b] / exact[b] - 1.0));
         exact_radiance.push(std::array::from_fn(|b| exact[b] / reference[b] - 1.0));
         coarse_radiance.push(std::array::from_fn(|b| coarse[b] / reference[b] - 1.0));
-        exact_converged.push(std::array::from_fn(|b| exact[b] / converged[s][b] - 1.0));
+        exact_converged.push(std::array::from_fn(|b| exact[b] / converged[s].2[b] - 1.0));
     }
     // (mean, 90th percentile, max) of the absolute relative differences.
     let (oe, ee, ce, ec) = (
