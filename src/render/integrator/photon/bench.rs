@@ -12,7 +12,7 @@ use rayon::prelude::*;
 use super::estimate::PhotonMap;
 use super::kdtree::{KdTree, Neighbors};
 use super::record::{Photon, RawPhoton};
-use super::trace::{PhotonStream, emit, in_chunks, trace_photon};
+use super::trace::{PhotonPass, PhotonStream};
 use crate::math::hash::Pcg32;
 use crate::render::world::World;
 use crate::render::{Overrides, Progress, Session};
@@ -72,28 +72,29 @@ impl fmt::Display for PhotonBenchFigures {
 
 /// Traces `n` photons of the global pass of `world` and returns their diffuse hits.
 pub fn trace_photons(world: &World, n: u64, max_depth: u32) -> Vec<RawPhoton> {
-    let stream = PhotonStream::new(SamplerKind::Sobol, 1, &[0xbe4c]);
-    let chunks = in_chunks(n, |range| {
-        let mut out = Vec::new();
-        for i in range {
-            let mut sampler = stream.sampler(i);
-            if let Some((ray, power)) = emit(world, None, n as f64, &mut sampler) {
-                trace_photon(world, ray, power, max_depth, &mut sampler, |l| {
-                    out.push(RawPhoton {
-                        p: l.hit.p,
-                        power: l.power,
-                        wi: l.wi,
-                        n: l.hit.ng,
-                        bounces: l.bounces.min(255) as u8,
-                        flags: 0,
-                    });
-                    true
-                });
-            }
-        }
-        out
-    });
-    chunks.concat()
+    PhotonPass {
+        world,
+        stream: PhotonStream::new(SamplerKind::Sobol, 1, &[0xbe4c]),
+        photons: n,
+        emitted_of: n as f64,
+        projection: None,
+        max_depth,
+    }
+    .trace(
+        || false,
+        |l, out| {
+            out.push(RawPhoton {
+                p: l.hit.p,
+                power: l.power,
+                wi: l.wi,
+                n: l.hit.ng,
+                bounces: l.bounces.min(255) as u8,
+                flags: 0,
+            });
+            true
+        },
+    )
+    .0
 }
 
 /// Runs every measurement; `quick` shrinks the workloads.

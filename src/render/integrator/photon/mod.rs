@@ -46,7 +46,7 @@ pub use settings::{Kernel, PhotonSettings, Visualize};
 use crate::render::Progress;
 use crate::render::world::World;
 use crate::scene::SamplerKind;
-use trace::{Landing, PhotonStream, emit, in_chunks, trace_photon};
+use trace::{Landing, PhotonPass, PhotonStream};
 
 /// Stream tags of the two photon passes.
 const GLOBAL_PASS: u64 = 0x0091_06a1;
@@ -136,28 +136,23 @@ impl PhotonMaps {
 
         // Global pass: all paths; store indirect hits (everything when visualizing).
         let n_global = settings.photons as u64;
-        let stream = PhotonStream::new(kind, seed, &[GLOBAL_PASS]);
-        let chunks = in_chunks(n_global, |range| {
-            let mut out = Vec::new();
-            let mut rays = 0u64;
-            if progress.cancelled() {
-                return (out, rays);
-            }
-            for i in range {
-                let mut sampler = stream.sampler(i);
-                let Some((ray, power)) = emit(world, None, n_global as f64, &mut sampler) else {
-                    continue;
-                };
-                rays += trace_photon(world, ray, power, settings.max_depth, &mut sampler, |l| {
-                    if visualize || !l.specular_chain {
-                        out.push(raw_photon(l));
-                    }
-                    true
-                }) as u64;
-            }
-            (out, rays)
-        });
-        let (global_raw, global_rays) = concat(chunks);
+        let (global_raw, global_rays) = PhotonPass {
+            world,
+            stream: PhotonStream::new(kind, seed, &[GLOBAL_PASS]),
+            photons: n_global,
+            emitted_of: n_global as f64,
+            projection: None,
+            max_depth: settings.max_depth,
+        }
+        .trace(
+            || progress.cancelled(),
+            |l, out| {
+                if visualize || !l.specular_chain {
+                    out.push(raw_photon(l));
+                }
+                true
+            },
+        );
 
         // Caustic pass: paths stop at the first diffuse hit; only L S+ D is kept.
         let specular = !world.specular_bounds().is_empty();
@@ -171,30 +166,23 @@ impl PhotonMaps {
         } else {
             0
         };
-        let stream = PhotonStream::new(kind, seed, &[CAUSTIC_PASS]);
-        let chunks = in_chunks(n_caustic, |range| {
-            let mut out = Vec::new();
-            let mut rays = 0u64;
-            if progress.cancelled() {
-                return (out, rays);
-            }
-            for i in range {
-                let mut sampler = stream.sampler(i);
-                let Some((ray, power)) =
-                    emit(world, projection.as_ref(), n_caustic as f64, &mut sampler)
-                else {
-                    continue;
-                };
-                rays += trace_photon(world, ray, power, settings.max_depth, &mut sampler, |l| {
-                    if l.specular_chain && l.bounces > 0 {
-                        out.push(raw_photon(l));
-                    }
-                    false
-                }) as u64;
-            }
-            (out, rays)
-        });
-        let (caustic_raw, caustic_rays) = concat(chunks);
+        let (caustic_raw, caustic_rays) = PhotonPass {
+            world,
+            stream: PhotonStream::new(kind, seed, &[CAUSTIC_PASS]),
+            photons: n_caustic,
+            emitted_of: n_caustic as f64,
+            projection: projection.as_ref(),
+            max_depth: settings.max_depth,
+        }
+        .trace(
+            || progress.cancelled(),
+            |l, out| {
+                if l.specular_chain && l.bounces > 0 {
+                    out.push(raw_photon(l));
+                }
+                false
+            },
+        );
         stats.trace_seconds = t0.elapsed().as_secs_f64();
         stats.global_emitted = n_global;
         stats.caustic_emitted = n_caustic;
@@ -257,17 +245,6 @@ fn raw_photon(l: &Landing) -> RawPhoton {
         bounces: l.bounces.min(255) as u8,
         flags,
     }
-}
-
-fn concat(chunks: Vec<(Vec<RawPhoton>, u64)>) -> (Vec<RawPhoton>, u64) {
-    let total: usize = chunks.iter().map(|c| c.0.len()).sum();
-    let mut out = Vec::with_capacity(total);
-    let mut rays = 0;
-    for (c, r) in chunks {
-        out.extend_from_slice(&c);
-        rays += r;
-    }
-    (out, rays)
 }
 
 /// Unit normal `n` turned to the side of `w`.

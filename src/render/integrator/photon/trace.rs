@@ -11,8 +11,6 @@
 //! fixed-size chunks on rayon and their results are concatenated in chunk order, so
 //! everything traced is identical at any thread count.
 
-use std::ops::Range;
-
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -174,12 +172,57 @@ pub fn trace_photon(
     rays
 }
 
-/// Runs `work` over `0..n` in chunks of [`CHUNK`] in parallel and returns the chunk
-/// results in order (so that their concatenation does not depend on the threads).
-pub fn in_chunks<R: Send>(n: u64, work: impl Fn(Range<u64>) -> R + Sync) -> Vec<R> {
-    let chunks = n.div_ceil(CHUNK);
-    (0..chunks)
-        .into_par_iter()
-        .map(|c| work(c * CHUNK..((c + 1) * CHUNK).min(n)))
-        .collect()
+/// One photon pass: photons `0..photons` of `stream`, each emitted by [`emit`] as one
+/// of `emitted_of` (through `projection` when given) and traced to `max_depth`.
+pub struct PhotonPass<'a> {
+    pub world: &'a World,
+    pub stream: PhotonStream,
+    pub photons: u64,
+    pub emitted_of: f64,
+    pub projection: Option<&'a ProjectionMaps>,
+    pub max_depth: u32,
+}
+
+impl PhotonPass<'_> {
+    /// Traces the pass in parallel chunks of [`CHUNK`] photons whose outputs are
+    /// concatenated in order, so the result does not depend on the threads. `land` sees
+    /// every landing with its chunk's output and says whether the photon goes on (as in
+    /// [`trace_photon`]); a chunk that starts once `cancelled()` holds traces nothing.
+    /// Returns the outputs and the number of rays traced.
+    pub fn trace<T: Send>(
+        &self,
+        cancelled: impl Fn() -> bool + Sync,
+        land: impl Fn(&Landing, &mut Vec<T>) -> bool + Sync,
+    ) -> (Vec<T>, u64) {
+        let chunks: Vec<(Vec<T>, u64)> = (0..self.photons.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let mut out = Vec::new();
+                let mut rays = 0u64;
+                if cancelled() {
+                    return (out, rays);
+                }
+                for i in c * CHUNK..((c + 1) * CHUNK).min(self.photons) {
+                    let mut sampler = self.stream.sampler(i);
+                    let Some((ray, power)) =
+                        emit(self.world, self.projection, self.emitted_of, &mut sampler)
+                    else {
+                        continue;
+                    };
+                    rays +=
+                        trace_photon(self.world, ray, power, self.max_depth, &mut sampler, |l| {
+                            land(l, &mut out)
+                        }) as u64;
+                }
+                (out, rays)
+            })
+            .collect();
+        let mut out = Vec::with_capacity(chunks.iter().map(|c| c.0.len()).sum());
+        let mut rays = 0;
+        for (chunk, chunk_rays) in chunks {
+            out.extend(chunk);
+            rays += chunk_rays;
+        }
+        (out, rays)
+    }
 }

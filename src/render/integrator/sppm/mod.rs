@@ -29,7 +29,7 @@ use rayon::prelude::*;
 pub use settings::SppmSettings;
 
 use super::footprint::pixel_footprint;
-use super::photon::trace::{PhotonStream, emit, in_chunks, trace_photon};
+use super::photon::trace::{PhotonPass, PhotonStream};
 use crate::color::Rgb;
 use crate::image::Image;
 use crate::math::{Frame, PI};
@@ -182,56 +182,48 @@ pub fn render(
         stats.camera_seconds += t0.elapsed().as_secs_f64();
 
         let t1 = Instant::now();
-        let stream = PhotonStream::new(session.sampler, seed, &[SPPM_PASS, it as u64]);
-        let chunks = in_chunks(n_photons, |range| {
-            let mut hits: Vec<(u32, Rgb)> = Vec::new();
-            let mut rays = 0u64;
-            if progress.cancelled() {
-                return (hits, rays);
-            }
-            for i in range {
-                let mut sampler = stream.sampler(i);
-                let Some((ray, power)) = emit(world, None, 1.0, &mut sampler) else {
-                    continue;
-                };
-                rays += trace_photon(world, ray, power, settings.max_depth, &mut sampler, |l| {
-                    // Direct light is next-event estimation's: skip first hits.
-                    if l.bounces == 0 {
-                        return true;
+        let (hits, photon_rays) = PhotonPass {
+            world,
+            stream: PhotonStream::new(session.sampler, seed, &[SPPM_PASS, it as u64]),
+            photons: n_photons,
+            emitted_of: 1.0,
+            projection: None,
+            max_depth: settings.max_depth,
+        }
+        .trace(
+            || progress.cancelled(),
+            |l, out: &mut Vec<(u32, Rgb)>| {
+                // Direct light is next-event estimation's: skip first hits.
+                if l.bounces == 0 {
+                    return true;
+                }
+                let p = l.hit.p;
+                for e in grid.candidates(p) {
+                    if (Vec3::from_array(e.centre) - p).length_squared() >= e.r2 {
+                        continue;
                     }
-                    let p = l.hit.p;
-                    for e in grid.candidates(p) {
-                        if (Vec3::from_array(e.centre) - p).length_squared() >= e.r2 {
-                            continue;
-                        }
-                        let j = e.index;
-                        let vp = &samples[j as usize].vp;
-                        if l.wi.dot(vp.n) <= 0.0 {
-                            continue;
-                        }
-                        let material = &world.materials[vp.material as usize];
-                        let f = material.eval(vp.wo, Frame::from_normal(vp.ns).to_local(l.wi));
-                        if !f.is_black() {
-                            hits.push((j, l.power * f));
-                        }
+                    let j = e.index;
+                    let vp = &samples[j as usize].vp;
+                    if l.wi.dot(vp.n) <= 0.0 {
+                        continue;
                     }
-                    true
-                }) as u64;
-            }
-            (hits, rays)
-        });
+                    let material = &world.materials[vp.material as usize];
+                    let f = material.eval(vp.wo, Frame::from_normal(vp.ns).to_local(l.wi));
+                    if !f.is_black() {
+                        out.push((j, l.power * f));
+                    }
+                }
+                true
+            },
+        );
         if progress.cancelled() {
             break;
         }
         phi.fill(Rgb::BLACK);
         count.fill(0);
-        let mut photon_rays = 0;
-        for (hits, rays) in &chunks {
-            photon_rays += rays;
-            for &(j, c) in hits {
-                phi[j as usize] += c;
-                count[j as usize] += 1;
-            }
+        for &(j, c) in &hits {
+            phi[j as usize] += c;
+            count[j as usize] += 1;
         }
         let alpha = settings.alpha as f64;
         state
