@@ -282,26 +282,14 @@ mod tests {
     use super::*;
     use crate::radiosity::settings::RadiositySettings;
     use crate::scene::builtin::cornell_box;
-    use crate::scene::{FileLoc, Geometry, ShapeDesc};
+    use crate::scene::{FileLoc, ShapeDesc};
     use glam::Vec3;
 
     /// A 4 x 3 rectangle in the plane y = 0 facing +y, and a wall x = 0 facing +x
     /// sharing its edge, both white.
     fn floor_and_wall(two_sided: bool) -> RadiosityScene {
         let mut desc = cornell_box();
-        let quad = |p: [Vec3; 4]| ShapeDesc {
-            geometry: Geometry::TriangleMesh {
-                positions: p.to_vec(),
-                indices: vec![0, 1, 2, 0, 2, 3],
-                normals: None,
-                uvs: None,
-            },
-            render_from_object: Default::default(),
-            reverse_orientation: false,
-            material: 0,
-            area_light: None,
-            loc: FileLoc::builtin("test"),
-        };
+        let quad = |p: [Vec3; 4]| ShapeDesc::quads(&[p], 0, FileLoc::builtin("test"));
         desc.shapes = vec![
             quad([
                 Vec3::ZERO,

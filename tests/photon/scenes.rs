@@ -8,7 +8,7 @@ use radiant::render::integrator::photon::{PhotonMaps, PhotonSettings};
 use radiant::render::world::World;
 use radiant::scene::builtin::{LIGHT_LE, cornell_caustics};
 use radiant::scene::params::ParamSet;
-use radiant::scene::{Geometry, IntegratorDesc, LightDesc, SamplerKind, SceneDesc};
+use radiant::scene::{IntegratorDesc, LightDesc, SamplerKind, SceneDesc, ShapeDesc};
 
 use crate::common;
 
@@ -57,19 +57,18 @@ pub fn reference(res: usize) -> Image {
 /// cornell-caustics with a front wall at z = 0 (facing the room): no photon escapes.
 pub fn closed_cornell_caustics() -> SceneDesc {
     let mut desc = cornell_caustics();
-    let mut wall = desc.shapes[0].clone();
-    wall.geometry = Geometry::TriangleMesh {
-        positions: vec![
+    // The white of the other walls.
+    let white = &desc.shapes[0];
+    let wall = ShapeDesc::quads(
+        &[[
             Vec3::new(0.0, 0.0, 0.0),
             Vec3::new(552.8, 0.0, 0.0),
             Vec3::new(556.0, 548.8, 0.0),
             Vec3::new(0.0, 548.8, 0.0),
-        ],
-        indices: vec![0, 1, 2, 0, 2, 3],
-        normals: None,
-        uvs: None,
-    };
-    wall.area_light = None;
+        ]],
+        white.material,
+        white.loc.clone(),
+    );
     desc.shapes.push(wall);
     desc
 }

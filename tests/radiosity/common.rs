@@ -84,3 +84,14 @@ pub fn max_abs_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
         .flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs()))
         .fold(0.0, f64::max)
 }
+
+/// The largest difference between `a` and `b` over all patches and bands, relative to
+/// the largest value of `b`.
+pub fn max_relative_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    let scale = b.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    a.iter()
+        .zip(b)
+        .flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs()))
+        .fold(0.0, f64::max)
+        / scale
+}

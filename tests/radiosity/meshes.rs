@@ -12,14 +12,7 @@ use radiant::radiosity::{
     solve_gauss_seidel, solve_jacobi, solve_progressive,
 };
 
-fn max_relative_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    let scale = b.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-    a.iter()
-        .zip(b)
-        .flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs()))
-        .fold(0.0, f64::max)
-        / scale
-}
+use crate::common::max_relative_difference;
 
 const TIGHT: IterationSettings = IterationSettings {
     tolerance: 1e-13,

@@ -13,6 +13,7 @@ use radiant::render::world::World;
 use radiant::scene::builtin::cornell_box;
 use radiant::scene::{FileLoc, Geometry, LightDesc, MaterialDesc, SceneDesc, ShapeDesc};
 
+use crate::common::max_relative_difference;
 use crate::mesh_checks::assert_conforming;
 
 fn settings_with_area(area: f64) -> RadiositySettings {
@@ -44,15 +45,6 @@ fn run<V: Visibility>(
         |_| ControlFlow::Continue(()),
     )
     .unwrap()
-}
-
-fn max_relative_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
-    let scale = b.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-    a.iter()
-        .zip(b)
-        .flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs()))
-        .fold(0.0, f64::max)
-        / scale
 }
 
 #[test]
@@ -190,24 +182,16 @@ fn floor_under_point_light(a: f32, h: f32, i: f32) -> SceneDesc {
     desc.materials = vec![MaterialDesc::Diffuse {
         reflectance: radiant::color::Rgb::splat(0.5),
     }];
-    desc.shapes = vec![ShapeDesc {
-        geometry: Geometry::TriangleMesh {
-            positions: vec![
-                Vec3::new(a, 0.0, -a),
-                Vec3::new(-a, 0.0, -a),
-                Vec3::new(-a, 0.0, a),
-                Vec3::new(a, 0.0, a),
-            ],
-            indices: vec![0, 1, 2, 0, 2, 3],
-            normals: None,
-            uvs: None,
-        },
-        render_from_object: Default::default(),
-        reverse_orientation: false,
-        material: 0,
-        area_light: None,
-        loc: FileLoc::builtin("test"),
-    }];
+    desc.shapes = vec![ShapeDesc::quads(
+        &[[
+            Vec3::new(a, 0.0, -a),
+            Vec3::new(-a, 0.0, -a),
+            Vec3::new(-a, 0.0, a),
+            Vec3::new(a, 0.0, a),
+        ]],
+        0,
+        FileLoc::builtin("test"),
+    )];
     desc.lights = vec![LightDesc::Point {
         position: Vec3::new(0.0, h, 0.0),
         intensity: radiant::color::Rgb::splat(i),
@@ -422,24 +406,22 @@ fn curved_bilinear_patches_are_meshed_on_their_surface() {
             0,
             None,
         ),
-        shape(
-            Geometry::TriangleMesh {
-                positions: vec![
+        ShapeDesc {
+            area_light: Some(AreaLightDesc {
+                l: radiant::color::Rgb::splat(1.0),
+                two_sided: false,
+            }),
+            ..ShapeDesc::quads(
+                &[[
                     Vec3::new(-1.0, 2.0, -1.0),
                     Vec3::new(2.0, 2.0, -1.0),
                     Vec3::new(2.0, 2.0, 2.0),
                     Vec3::new(-1.0, 2.0, 2.0),
-                ],
-                indices: vec![0, 1, 2, 0, 2, 3],
-                normals: None,
-                uvs: None,
-            },
-            0,
-            Some(AreaLightDesc {
-                l: radiant::color::Rgb::splat(1.0),
-                two_sided: false,
-            }),
-        ),
+                ]],
+                0,
+                FileLoc::builtin("test"),
+            )
+        },
     ];
     desc.lights.clear();
     let settings = RadiositySettings {
