@@ -13,7 +13,9 @@ use glam::{DMat4, DVec3, Vec3};
 use super::mesh::{FaceMesh, Subdivision};
 use super::patch::PatchSet;
 use super::settings::{DEFAULT_PATCH_COUNT, RadiositySettings};
-use crate::scene::{Geometry, LightDesc, MaterialDesc, SceneDesc, SceneError, ShapeDesc, Warning};
+use crate::scene::{
+    Geometry, LightDesc, MaterialDesc, SceneDesc, SceneError, ShapeDesc, Warning, sphere_z_range,
+};
 
 /// What every patch of one input face carries.
 #[derive(Clone, Debug, PartialEq)]
@@ -217,13 +219,6 @@ fn scale_of(xf: &DMat4) -> f64 {
     xf.determinant().abs().cbrt()
 }
 
-fn sphere_z_range(radius: f32, z_min: f32, z_max: f32) -> (f64, f64) {
-    let r = radius.abs() as f64;
-    let a = (z_min as f64).clamp(-r, r);
-    let b = (z_max as f64).clamp(-r, r);
-    (a.min(b), a.max(b))
-}
-
 /// Adds the faces of one shape, wound so that their normal is the shape's front.
 fn add_shape(
     faces: &mut FaceMesh,
@@ -316,6 +311,7 @@ fn add_shape(
         } => {
             let r = radius.abs() as f64;
             let (zl, zh) = sphere_z_range(*radius, *z_min, *z_max);
+            let (zl, zh) = (zl as f64, zh as f64);
             let (theta_top, theta_bottom) = (
                 (zh / r).clamp(-1.0, 1.0).acos(),
                 (zl / r).clamp(-1.0, 1.0).acos(),

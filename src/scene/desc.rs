@@ -288,6 +288,14 @@ pub enum LightDesc {
     Infinite { radiance: Rgb, loc: FileLoc },
 }
 
+/// The z range `(low, high)` of a sphere of `radius` cut at `z_min` and `z_max`, as
+/// pbrt-v4 reads them: clamped to the sphere, either order.
+pub fn sphere_z_range(radius: f32, z_min: f32, z_max: f32) -> (f32, f32) {
+    let r = radius.abs();
+    let (a, b) = (z_min.clamp(-r, r), z_max.clamp(-r, r));
+    (a.min(b), a.max(b))
+}
+
 impl Geometry {
     /// Surface area in render space. Meshes are measured after the transform; spheres
     /// and disks by their object-space formula times the transform's mean area scale
@@ -325,9 +333,8 @@ impl Geometry {
                 z_max,
                 phi_max_deg,
             } => {
-                let r = radius.abs();
-                let (a, b) = (z_min.clamp(-r, r), z_max.clamp(-r, r));
-                phi(*phi_max_deg) * r * (a - b).abs() * area_scale
+                let (low, high) = sphere_z_range(*radius, *z_min, *z_max);
+                phi(*phi_max_deg) * radius.abs() * (high - low) * area_scale
             }
             Geometry::Disk {
                 radius,
