@@ -469,15 +469,7 @@ impl FaceBuilder<'_> {
                     };
                 }
             }
-            let g = |i: usize, j: usize| grid[row_start(j) + i];
-            for j in 0..m {
-                for i in 0..m - j {
-                    self.patch(&[g(i, j), g(i + 1, j), g(i, j + 1)]);
-                    if i + j + 1 < m {
-                        self.patch(&[g(i + 1, j), g(i + 1, j + 1), g(i, j + 1)]);
-                    }
-                }
-            }
+            self.grid_patches(m, |i, j| grid[row_start(j) + i]);
             return;
         }
         if m < 4 {
@@ -494,14 +486,7 @@ impl FaceBuilder<'_> {
             }
         }
         let g = |i: usize, j: usize| core[core_start(j) + i];
-        for j in 0..level {
-            for i in 0..level - j {
-                self.patch(&[g(i, j), g(i + 1, j), g(i, j + 1)]);
-                if i + j + 1 < level {
-                    self.patch(&[g(i + 1, j), g(i + 1, j + 1), g(i, j + 1)]);
-                }
-            }
-        }
+        self.grid_patches(level, g);
         let sides: [Vec<u32>; 3] = [
             (0..=level).map(|i| g(i, 0)).collect(),
             (0..=level).map(|j| g(level - j, j)).collect(),
@@ -533,6 +518,19 @@ impl FaceBuilder<'_> {
             } else {
                 self.patch(&[outer[s], inner[k + 1], inner[k]]);
                 k += 1;
+            }
+        }
+    }
+
+    /// The patches of a triangular grid of `m` steps per side whose point (i, j),
+    /// i + j <= m, is `g(i, j)`: per row, upright triangles and the inverted ones between.
+    fn grid_patches(&mut self, m: usize, g: impl Fn(usize, usize) -> u32) {
+        for j in 0..m {
+            for i in 0..m - j {
+                self.patch(&[g(i, j), g(i + 1, j), g(i, j + 1)]);
+                if i + j + 1 < m {
+                    self.patch(&[g(i + 1, j), g(i + 1, j + 1), g(i, j + 1)]);
+                }
             }
         }
     }
