@@ -1,7 +1,13 @@
 //! Reading the shared reference data.
 
+use std::ops::ControlFlow;
+
 use radiant::math::DVec3;
-use radiant::radiosity::PatchSet;
+use radiant::radiosity::scene::RadiosityScene;
+use radiant::radiosity::settings::RadiositySettings;
+use radiant::radiosity::solve::{Solution, solve};
+use radiant::radiosity::{PatchSet, Visibility};
+use radiant::render::world::World;
 use serde_json::Value;
 
 /// Parses `../shared/data/<name>`.
@@ -94,4 +100,22 @@ pub fn max_relative_difference(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
         .flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs()))
         .fold(0.0, f64::max)
         / scale
+}
+
+/// The solution of `scene` lit by `world`'s lights, solved without interruption.
+pub fn solve_to_end<V: Visibility>(
+    scene: &RadiosityScene,
+    world: &World,
+    settings: &RadiositySettings,
+    vis: &V,
+) -> Solution {
+    solve(
+        scene,
+        &world.lights,
+        world.scene_sphere(),
+        settings,
+        vis,
+        |_| ControlFlow::Continue(()),
+    )
+    .unwrap()
 }

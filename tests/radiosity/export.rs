@@ -1,17 +1,18 @@
 //! The lit mesh and patch table written by `radiant radiosity --export/--patches`,
 //! read back with independent readers (ply-rs-bw, serde_json).
 
-use std::ops::ControlFlow;
 use std::path::PathBuf;
 
 use radiant::radiosity::export::{LitMesh, write_gltf, write_patch_csv, write_ply};
 use radiant::radiosity::render::Shading;
 use radiant::radiosity::scene::RadiosityScene;
 use radiant::radiosity::settings::RadiositySettings;
-use radiant::radiosity::solve::{Solution, solve};
+use radiant::radiosity::solve::Solution;
 use radiant::radiosity::world_visibility::FaceVisibility;
 use radiant::render::world::World;
 use radiant::scene::builtin::cornell_box;
+
+use crate::common::solve_to_end;
 
 /// A scratch folder unique to this test process.
 fn scratch(name: &str) -> PathBuf {
@@ -29,15 +30,7 @@ fn lit_cornell() -> (RadiosityScene, Solution, LitMesh) {
     let scene = RadiosityScene::from_desc(&desc, &settings).unwrap();
     let (world, _) = World::build(&desc).unwrap();
     let vis = FaceVisibility::new(&scene);
-    let solution = solve(
-        &scene,
-        &world.lights,
-        world.scene_sphere(),
-        &settings,
-        &vis,
-        |_| ControlFlow::Continue(()),
-    )
-    .unwrap();
+    let solution = solve_to_end(&scene, &world, &settings, &vis);
     let display = solution.display_radiosity(&scene.patches);
     let shading = Shading::new(&scene, &world, &display, &solution.irradiance, 0);
     let mesh = LitMesh::new(&scene, shading.mesh(), shading.vertex_radiosity());

@@ -13,7 +13,7 @@ use radiant::render::world::World;
 use radiant::scene::builtin::cornell_box;
 use radiant::scene::{FileLoc, Geometry, LightDesc, MaterialDesc, SceneDesc, ShapeDesc};
 
-use crate::common::max_relative_difference;
+use crate::common::{max_relative_difference, solve_to_end};
 use crate::mesh_checks::assert_conforming;
 
 fn settings_with_area(area: f64) -> RadiositySettings {
@@ -28,23 +28,6 @@ fn cornell(area: f64) -> (SceneDesc, RadiosityScene, World) {
     let scene = RadiosityScene::from_desc(&desc, &settings_with_area(area)).unwrap();
     let (world, _) = World::build(&desc).unwrap();
     (desc, scene, world)
-}
-
-fn run<V: Visibility>(
-    scene: &RadiosityScene,
-    world: &World,
-    settings: &RadiositySettings,
-    vis: &V,
-) -> Solution {
-    solve(
-        scene,
-        &world.lights,
-        world.scene_sphere(),
-        settings,
-        vis,
-        |_| ControlFlow::Continue(()),
-    )
-    .unwrap()
 }
 
 #[test]
@@ -100,8 +83,8 @@ fn shaft_culled_face_visibility_agrees_with_the_world_bvh() {
         tolerance: 1e-3,
         ..settings_with_area(4000.0)
     };
-    let with_faces = run(&scene, &world, &settings, &faces);
-    let with_world = run(&scene, &world, &settings, &render);
+    let with_faces = solve_to_end(&scene, &world, &settings, &faces);
+    let with_world = solve_to_end(&scene, &world, &settings, &render);
     let difference = max_relative_difference(&with_faces.radiosity, &with_world.radiosity);
     eprintln!("{disagree} of {pairs} pairs disagree; radiosities differ by {difference:e}");
     assert!(difference < 1e-3);
@@ -123,8 +106,8 @@ fn factor_methods_and_solvers_agree_on_the_cornell_box() {
         tolerance: 1e-4,
         ..settings_with_area(4000.0)
     };
-    let progressive = run(&scene, &world, &base, &vis);
-    let seidel = run(
+    let progressive = solve_to_end(&scene, &world, &base, &vis);
+    let seidel = solve_to_end(
         &scene,
         &world,
         &RadiositySettings {
@@ -134,7 +117,7 @@ fn factor_methods_and_solvers_agree_on_the_cornell_box() {
         },
         &vis,
     );
-    let hemicube = run(
+    let hemicube = solve_to_end(
         &scene,
         &world,
         &RadiositySettings {
@@ -216,7 +199,7 @@ fn point_light_is_the_first_shot() {
     let scene = RadiosityScene::from_desc(&desc, &settings).unwrap();
     let (world, _) = World::build(&desc).unwrap();
     let vis = FaceVisibility::new(&scene);
-    let solution = run(&scene, &world, &settings, &vis);
+    let solution = solve_to_end(&scene, &world, &settings, &vis);
     let (a, h, i) = (a as f64, h as f64, i as f64);
     let omega = 4.0 * (a * a / (a * a + h * h)).asin();
     let arrived: f64 = scene
@@ -432,7 +415,7 @@ fn curved_bilinear_patches_are_meshed_on_their_surface() {
     assert!(scene.warnings.iter().any(|w| w.message.contains("curved")));
     let (world, _) = World::build(&desc).unwrap();
     let vis = FaceVisibility::new(&scene);
-    let solution = run(&scene, &world, &settings, &vis);
+    let solution = solve_to_end(&scene, &world, &settings, &vis);
     let surface: Vec<usize> = (0..scene.patches.len())
         .filter(|&i| scene.patches.patches[i].emission == [0.0; 3])
         .collect();

@@ -151,15 +151,7 @@ fn contrast_marks_follow_the_shadow_edges() {
         tolerance: 1e-2,
         ..RadiositySettings::default()
     };
-    let solution = radiant::radiosity::solve::solve(
-        &base,
-        &world.lights,
-        world.scene_sphere(),
-        &settings,
-        &vis,
-        |_| ControlFlow::Continue(()),
-    )
-    .unwrap();
+    let solution = crate::common::solve_to_end(&base, &world, &settings, &vis);
     let marks = contrast_marks(
         &base,
         &solution.display_radiosity(&base.patches),
