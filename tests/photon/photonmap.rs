@@ -76,9 +76,7 @@ fn visualisations_show_the_maps() {
     }
     // Dots: photons light some pixels, not all (at 64 × 64 a pixel is 12 mm wide).
     let params = quick_params().with("visualize", ParamValue::String(vec!["photons".into()]));
-    let mut desc = with_integrator(cornell_caustics(), "photonmap", params, None);
-    desc.film.xresolution = 64;
-    desc.film.yresolution = 64;
+    let desc = with_integrator(cornell_caustics(), "photonmap", params, Some(64));
     let img = common::render(
         &desc,
         &Overrides {
@@ -101,9 +99,7 @@ fn visualisations_show_the_maps() {
 /// image close to the reference (relMSE below 0.03: 4 spp of 8 gather rays are noisy).
 #[test]
 fn cornell_caustics_caustic_matches_the_reference() {
-    let mut desc = with_integrator(cornell_caustics(), "photonmap", quick_params(), None);
-    desc.film.xresolution = 64;
-    desc.film.yresolution = 64;
+    let desc = with_integrator(cornell_caustics(), "photonmap", quick_params(), Some(64));
     let img = common::render(
         &desc,
         &Overrides {
@@ -130,9 +126,7 @@ fn cornell_caustics_caustic_matches_the_reference() {
 /// Photon maps and images are identical at any thread count.
 #[test]
 fn photon_maps_are_identical_at_one_and_two_threads() {
-    let mut desc = with_integrator(cornell_caustics(), "photonmap", quick_params(), None);
-    desc.film.xresolution = 24;
-    desc.film.yresolution = 24;
+    let desc = with_integrator(cornell_caustics(), "photonmap", quick_params(), Some(24));
     let run = |threads| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
