@@ -104,7 +104,18 @@ pub fn radiance(
         let wo = frame.to_local(wo_world);
         let bsdf = |wi: Vec3| material.eval(wo, frame.to_local(wi));
         let maps = ctx.maps;
-        let kernel = settings.kernel;
+        // Radiance reflected towards the viewer by the photons of one map near the point.
+        let estimate = |map, skip_flags, neighbours: &mut _| {
+            radiance_estimate(
+                map,
+                &at,
+                maps.max_r2,
+                settings.kernel,
+                skip_flags,
+                neighbours,
+                bsdf,
+            )
+        };
         let reflected = match settings.visualize {
             Visualize::None => {
                 l += beta * emitted;
@@ -115,69 +126,22 @@ pub fn radiance(
                     &mut rays,
                 )
                 .map_or(Rgb::BLACK, |d| d.unweighted());
-                let caustic = radiance_estimate(
-                    &maps.caustic,
-                    &at,
-                    maps.max_r2,
-                    kernel,
-                    0,
-                    &mut scratch.caustic,
-                    bsdf,
-                );
+                let caustic = estimate(&maps.caustic, 0, &mut scratch.caustic);
                 let indirect = if settings.final_gather_samples > 0 {
                     final_gather(
                         ctx, &hit, &material, &frame, wo, wo_world, gather, scratch, &mut rays,
                     )
                 } else {
-                    radiance_estimate(
-                        &maps.global,
-                        &at,
-                        maps.max_r2,
-                        kernel,
-                        0,
-                        &mut scratch.global,
-                        bsdf,
-                    )
+                    estimate(&maps.global, 0, &mut scratch.global)
                 };
                 direct + caustic + indirect
             }
-            Visualize::Caustic => radiance_estimate(
-                &maps.caustic,
-                &at,
-                maps.max_r2,
-                kernel,
-                0,
-                &mut scratch.caustic,
-                bsdf,
-            ),
-            Visualize::Global => radiance_estimate(
-                &maps.global,
-                &at,
-                maps.max_r2,
-                kernel,
-                FIRST_DIFFUSE,
-                &mut scratch.global,
-                bsdf,
-            ),
+            Visualize::Caustic => estimate(&maps.caustic, 0, &mut scratch.caustic),
+            Visualize::Global => estimate(&maps.global, FIRST_DIFFUSE, &mut scratch.global),
             Visualize::Density => {
                 l += beta * emitted;
-                radiance_estimate(
-                    &maps.global,
-                    &at,
-                    maps.max_r2,
-                    kernel,
-                    0,
-                    &mut scratch.global,
-                    bsdf,
-                ) + radiance_estimate(
-                    &maps.caustic,
-                    &at,
-                    maps.max_r2,
-                    kernel,
-                    0,
-                    &mut scratch.caustic,
-                    bsdf,
-                )
+                estimate(&maps.global, 0, &mut scratch.global)
+                    + estimate(&maps.caustic, 0, &mut scratch.caustic)
             }
             Visualize::Photons => photon_dots(maps, &at, 0.75 * ctx.pixel_angle * travelled),
         };
