@@ -1,0 +1,402 @@
+//! `radiant radiosity`: solve a scene's diffuse transport on a patch mesh, print the
+//! energy balance, and write the lit mesh, the patch table, an image or the classic
+//! progressive-refinement sequence.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::Ordering;
+
+use anyhow::{Context, bail};
+use clap::Args;
+use radiant::image::{ImageMeta, write_image};
+use radiant::radiosity::RadiosityIntegrator;
+use radiant::radiosity::export::{LitMesh, write_lit_mesh, write_patch_csv, write_ply};
+use radiant::radiosity::render::{Shading, solve_session_observed};
+use radiant::radiosity::settings::RadiositySettings;
+use radiant::radiosity::solve::SolveEvent;
+use radiant::render::integrator::render_passes;
+use radiant::render::{Overrides, Progress, RenderContext, RenderControl};
+use radiant::scene::{FileLoc, Param, ParamValue};
+
+use crate::render_cmd::{draw_progress, interruptible_progress, load_scene, worker_pool};
+
+#[derive(Args, Debug)]
+pub struct RadiosityArgs {
+    /// A pbrt-v4 scene file, or a canonical scene: cornell-box (default), cornell-caustics, furnace.
+    pub scene: Option<String>,
+    /// Write the lit mesh with linear float vertex colours (radiance B/pi): .gltf (+ .bin), .glb or .ply.
+    #[arg(long)]
+    pub export: Option<PathBuf>,
+    /// Write PLY as ASCII instead of binary little-endian.
+    #[arg(long)]
+    pub ascii: bool,
+    /// Write one CSV row per patch: area, centroid, normal, reflectance, E, B, H.
+    #[arg(long)]
+    pub patches: Option<PathBuf>,
+    /// With --sequence: write an image every K progressive shots.
+    #[arg(long, value_name = "K")]
+    pub every: Option<usize>,
+    /// Image sequence name; the run of '#' becomes the frame number (out-####.png).
+    #[arg(long)]
+    pub sequence: Option<PathBuf>,
+    /// Render the solution from the scene camera to this image (.exr, .pfm, .png).
+    #[arg(short = 'o', long = "outfile")]
+    pub output: Option<PathBuf>,
+    /// Largest patch area in scene units squared ("maxpatcharea").
+    #[arg(long)]
+    pub max_patch_area: Option<f32>,
+    /// Split every input edge into at least this many segments ("subdivision").
+    #[arg(long)]
+    pub subdivision: Option<u32>,
+    /// Form factors: raycast or hemicube ("formfactor").
+    #[arg(long)]
+    pub formfactor: Option<String>,
+    /// Hemi-cube resolution ("hemicuberes").
+    #[arg(long)]
+    pub hemicube_res: Option<u32>,
+    /// Solver: progressive, gaussseidel or jacobi ("solver").
+    #[arg(long)]
+    pub solver: Option<String>,
+    /// Unshot fraction (progressive) or sweep change (matrix solvers) to stop at ("tolerance").
+    #[arg(long)]
+    pub tolerance: Option<f32>,
+    /// Most shots or sweeps ("maxiterations").
+    #[arg(long)]
+    pub max_iterations: Option<u32>,
+    /// Final-gather rays per camera sample, 0 for Gouraud display ("finalgather").
+    #[arg(long)]
+    pub final_gather: Option<u32>,
+    /// Shadow rays against the patches' faces or the render world ("visibility").
+    #[arg(long)]
+    pub visibility: Option<String>,
+    /// Mesh the back side of non-emitting diffuse surfaces too ("twosided").
+    #[arg(long)]
+    pub two_sided: bool,
+    /// Adaptive refinement passes: split patches of strong contrast and solve again ("refine").
+    #[arg(long, value_name = "PASSES")]
+    pub refine: Option<u32>,
+    /// Neighbour radiosity contrast that splits patches ("refinethreshold").
+    #[arg(long)]
+    pub refine_threshold: Option<f32>,
+    /// Rows of elements halving towards contact edges, this many levels ("contactgrading").
+    #[arg(long, value_name = "LEVELS")]
+    pub contact_grading: Option<u32>,
+    /// Samples per pixel of the images.
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Image size as WIDTHxHEIGHT, overriding the film's.
+    #[arg(long, value_parser = crate::render_cmd::parse_resolution)]
+    pub resolution: Option<(u32, u32)>,
+    /// Worker threads (default: all cores).
+    #[arg(long, alias = "nthreads")]
+    pub threads: Option<usize>,
+    /// Exposure in stops for PNG output.
+    #[arg(long, default_value_t = 0.0)]
+    pub exposure: f32,
+    /// No progress bar and no summary (the energy balance is still printed).
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+impl RadiosityArgs {
+    /// The command-line settings as `Integrator "radiosity"` parameters, so they are
+    /// checked and documented in one place.
+    fn params(&self) -> Vec<Param> {
+        let loc = FileLoc::new("<command line>", 0, 0);
+        let mut out = Vec::new();
+        let mut push =
+            |name: &str, value: ParamValue| out.push(Param::new(name, value, loc.clone()));
+        if let Some(v) = self.max_patch_area {
+            push("maxpatcharea", ParamValue::Float(vec![v]));
+        }
+        if let Some(v) = self.subdivision {
+            push("subdivision", ParamValue::Int(vec![v as i32]));
+        }
+        if let Some(v) = &self.formfactor {
+            push("formfactor", ParamValue::String(vec![v.clone()]));
+        }
+        if let Some(v) = self.hemicube_res {
+            push("hemicuberes", ParamValue::Int(vec![v as i32]));
+        }
+        if let Some(v) = &self.solver {
+            push("solver", ParamValue::String(vec![v.clone()]));
+        }
+        if let Some(v) = self.tolerance {
+            push("tolerance", ParamValue::Float(vec![v]));
+        }
+        if let Some(v) = self.max_iterations {
+            push("maxiterations", ParamValue::Int(vec![v as i32]));
+        }
+        if let Some(v) = self.final_gather {
+            push("finalgather", ParamValue::Int(vec![v as i32]));
+        }
+        if let Some(v) = &self.visibility {
+            push("visibility", ParamValue::String(vec![v.clone()]));
+        }
+        if self.two_sided {
+            push("twosided", ParamValue::Bool(vec![true]));
+        }
+        if let Some(v) = self.refine {
+            push("refine", ParamValue::Int(vec![v as i32]));
+        }
+        if let Some(v) = self.refine_threshold {
+            push("refinethreshold", ParamValue::Float(vec![v]));
+        }
+        if let Some(v) = self.contact_grading {
+            push("contactgrading", ParamValue::Int(vec![v as i32]));
+        }
+        out
+    }
+}
+
+/// `out-####.png` with frame 7 -> `out-0007.png` (the last run of '#'; without one,
+/// `-0007` goes before the extension).
+fn frame_path(pattern: &Path, frame: usize) -> PathBuf {
+    let text = pattern.to_string_lossy();
+    if let Some(end) = text.rfind('#') {
+        let start = text[..=end].trim_end_matches('#').len();
+        let width = end + 1 - start;
+        return PathBuf::from(format!(
+            "{}{:0width$}{}",
+            &text[..start],
+            frame,
+            &text[end + 1..]
+        ));
+    }
+    let stem = pattern
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("frame");
+    let ext = pattern
+        .extension()
+        .and_then(|s| s.to_str())
+        .unwrap_or("png");
+    pattern.with_file_name(format!("{stem}-{frame:04}.{ext}"))
+}
+
+pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
+    let mut desc = load_scene(args.scene.as_deref())?;
+    for w in &desc.warnings {
+        eprintln!("{w}");
+    }
+    // The scene's own radiosity parameters, if it asks for radiosity, then ours on top.
+    if desc.integrator.name != "radiosity" {
+        desc.integrator.name = "radiosity".into();
+        desc.integrator.params = Default::default();
+    }
+    for p in args.params() {
+        desc.integrator.params.push(p);
+    }
+    if args.sequence.is_some() != args.every.is_some() {
+        bail!("--every K and --sequence NAME go together");
+    }
+    let overrides = Overrides {
+        spp: args.spp,
+        seed: None,
+        resolution: args.resolution,
+        integrator: None,
+    };
+    let settings = RadiositySettings::from_desc(&desc.integrator)?;
+    for w in desc
+        .integrator
+        .params
+        .unused_warnings("Integrator \"radiosity\"")
+    {
+        eprintln!("{w}");
+    }
+    let (radiosity, warnings) = RadiosityIntegrator::new(&desc, settings)?;
+    let (ctx, w) = RenderContext::new(&desc, &overrides)?;
+    for w in warnings.iter().chain(&w) {
+        eprintln!("{w}");
+    }
+    let (settings, scene) = (&radiosity.settings, &radiosity.scene);
+    let render_shading = |shading: &Shading, progress: &Progress| {
+        render_passes(
+            &ctx,
+            shading,
+            &mut RenderControl::new(progress, &mut |_, _| {}),
+        )
+    };
+    let progress = interruptible_progress()?;
+    let pool = worker_pool(args.threads)?;
+    let show_bar = !args.quiet && std::io::stderr().is_terminal();
+    let meta = |spp: u32, seconds: f64| ImageMeta {
+        samples_per_pixel: Some(spp),
+        render_time_seconds: Some(seconds),
+        software: format!("radiant {} radiosity", env!("CARGO_PKG_VERSION")),
+    };
+    if !args.quiet {
+        eprintln!(
+            "radiosity: {} patches (max edge {:.4} scene units), {:?} factors, {:?} solver",
+            scene.patches.len(),
+            scene.max_edge,
+            settings.form_factor,
+            settings.solver
+        );
+    }
+
+    // Solve, writing the progressive sequence on the way.
+    let mut frame_error = None;
+    let solved = std::thread::scope(|s| {
+        let bar_done = Arc::new(std::sync::atomic::AtomicBool::new(false));
+        if show_bar {
+            let progress = Arc::clone(&progress);
+            let bar_done = Arc::clone(&bar_done);
+            s.spawn(move || draw_progress(&progress, &bar_done));
+        }
+        let solved = pool.install(|| {
+            solve_session_observed(&ctx.world, scene, settings, &progress, |event| {
+                if let (
+                    SolveEvent::Shot {
+                        scene: mesh, state, ..
+                    },
+                    Some(every),
+                    Some(pattern),
+                ) = (event, args.every, &args.sequence)
+                    && every > 0
+                    && state.shots.is_multiple_of(every)
+                    && frame_error.is_none()
+                {
+                    let display = state.display_radiosity(&mesh.patches);
+                    let shading = Shading::new(mesh, &ctx.world, &display, &state.irradiance, 0)
+                        .with_specular_depth(settings.max_depth);
+                    let out = render_shading(&shading, &Progress::default());
+                    let path = frame_path(pattern, state.shots / every);
+                    if let Err(e) = write_image(
+                        &path,
+                        &out.film.image(),
+                        &meta(out.spp_done, out.seconds),
+                        args.exposure,
+                    ) {
+                        frame_error = Some(anyhow::anyhow!("writing {}: {e}", path.display()));
+                    }
+                }
+            })
+        });
+        bar_done.store(true, Ordering::SeqCst);
+        solved
+    })?;
+    if let Some(e) = frame_error {
+        return Err(e);
+    }
+    let scene = solved.scene(scene);
+    let solution = &solved.solution;
+    if !args.quiet && solved.passes > 0 {
+        eprintln!(
+            "refined: {} passes, {} patches",
+            solved.passes,
+            scene.patches.len()
+        );
+    }
+    if !args.quiet {
+        eprintln!(
+            "solved: {} {}, {}, {:.2} s (factors {:.2} s)",
+            solution.iterations,
+            if settings.solver == radiant::radiosity::settings::SolverKind::Progressive {
+                "shots"
+            } else {
+                "sweeps"
+            },
+            if solution.converged {
+                "converged"
+            } else {
+                "not converged"
+            },
+            solution.seconds,
+            solution.factor_seconds
+        );
+    }
+    println!("{}", solution.balance.summary());
+
+    let display = solution.display_radiosity(&scene.patches);
+    let shading = Shading::new(
+        scene,
+        &ctx.world,
+        &display,
+        &solution.irradiance,
+        settings.final_gather,
+    )
+    .with_specular_depth(settings.max_depth);
+    if let Some(path) = &args.export {
+        let mesh = LitMesh::new(scene, shading.mesh(), shading.vertex_radiosity());
+        let is_ply = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("ply"));
+        if args.ascii && is_ply {
+            write_ply(path, &mesh, true)?;
+        } else {
+            write_lit_mesh(path, &mesh)?;
+        }
+        if !args.quiet {
+            eprintln!(
+                "{}: {} vertices, {} faces",
+                path.display(),
+                mesh.positions.len(),
+                mesh.faces.len()
+            );
+        }
+    }
+    if let Some(path) = &args.patches {
+        write_patch_csv(path, scene, solution)?;
+    }
+    let wrote_something =
+        args.export.is_some() || args.patches.is_some() || args.sequence.is_some();
+    let output = match (&args.output, wrote_something) {
+        (Some(path), _) => Some(path.clone()),
+        (None, false) => Some(PathBuf::from(desc.output_name())),
+        (None, true) => None,
+    };
+    if let Some(path) = output
+        && !solution.interrupted
+    {
+        progress.done.store(0, Ordering::Relaxed);
+        let out = pool.install(|| render_shading(&shading, &progress));
+        write_image(
+            &path,
+            &out.film.image(),
+            &meta(out.spp_done, out.seconds + solution.seconds),
+            args.exposure,
+        )
+        .with_context(|| format!("writing {}", path.display()))?;
+        if !args.quiet {
+            eprintln!(
+                "{}: {}x{}, {} spp, final gather {}, {:.2} s",
+                path.display(),
+                ctx.resolution.0,
+                ctx.resolution.1,
+                out.spp_done,
+                settings.final_gather,
+                out.seconds
+            );
+        }
+    }
+    if solution.interrupted {
+        bail!(
+            "interrupted during the solve after {} iterations",
+            solution.iterations
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_names_fill_the_hashes() {
+        assert_eq!(
+            frame_path(Path::new("out/seq-####.png"), 7),
+            PathBuf::from("out/seq-0007.png")
+        );
+        assert_eq!(
+            frame_path(Path::new("a##b.exr"), 123),
+            PathBuf::from("a123b.exr")
+        );
+        assert_eq!(
+            frame_path(Path::new("frames.png"), 3),
+            PathBuf::from("frames-0003.png")
+        );
+    }
+}

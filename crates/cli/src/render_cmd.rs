@@ -1,0 +1,238 @@
+//! `radiant render`: render a scene file or a canonical scene to an image.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::Ordering;
+use std::time::Duration;
+
+use anyhow::{Context, bail};
+use clap::Args;
+use radiant::image::{ImageMeta, write_image};
+use radiant::render::{Overrides, Progress};
+use radiant::scene::{
+    SceneDesc,
+    builtin::{BUILTIN_SCENES, builtin_scene},
+};
+use radiant::{INTEGRATOR_NAMES, Session};
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// A pbrt-v4 scene file, or a canonical scene: cornell-box (default), cornell-caustics, furnace.
+    pub scene: Option<String>,
+    /// Samples per pixel (overrides the scene's Sampler "pixelsamples").
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Seed of the sampler (overrides the scene's).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long, alias = "nthreads")]
+    pub threads: Option<usize>,
+    /// Output image; the format follows the extension (.exr, .pfm, .png).
+    #[arg(short = 'o', long = "outfile")]
+    pub output: Option<PathBuf>,
+    /// Integrator, overriding the scene's (path, sppm, photonmap, photonviz, radiosity).
+    #[arg(long)]
+    pub integrator: Option<String>,
+    /// Also write the image whenever the samples per pixel (SPPM: iterations) reach a
+    /// power of two, as NAME-00016.EXT beside the output.
+    #[arg(long)]
+    pub snapshots: bool,
+    /// Image size as WIDTHxHEIGHT, overriding the film's.
+    #[arg(long, value_parser = parse_resolution)]
+    pub resolution: Option<(u32, u32)>,
+    /// Exposure in stops for PNG output.
+    #[arg(long, default_value_t = 0.0)]
+    pub exposure: f32,
+    /// No progress bar and no summary.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got \"{s}\""))?;
+    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|&n| n > 0);
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!("expected positive WIDTHxHEIGHT, got \"{s}\"")),
+    }
+}
+
+/// Reads a scene file, or builds a canonical scene by name.
+pub fn load_scene(scene: Option<&str>) -> anyhow::Result<SceneDesc> {
+    let name = scene.unwrap_or("cornell-box");
+    let path = Path::new(name);
+    if !path.exists() {
+        if let Some(desc) = builtin_scene(name) {
+            return Ok(desc);
+        }
+        if path.extension().is_none() {
+            bail!(
+                "{name}: no such scene file, and not a canonical scene ({})",
+                BUILTIN_SCENES.join(", ")
+            );
+        }
+    }
+    Ok(radiant::scene::parse_file(path)?)
+}
+
+pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    // A scene may name pbrt integrators radiant lacks (a warning, then the path tracer);
+    // a name typed on the command line must be one radiant has.
+    if let Some(name) = &args.integrator
+        && !INTEGRATOR_NAMES.contains(&name.as_str())
+    {
+        bail!(
+            "--integrator {name}: unknown integrator (radiant has: {})",
+            INTEGRATOR_NAMES.join(", ")
+        );
+    }
+    let desc = load_scene(args.scene.as_deref())?;
+    for w in &desc.warnings {
+        eprintln!("{w}");
+    }
+    let overrides = Overrides {
+        spp: args.spp,
+        seed: args.seed,
+        resolution: args.resolution,
+        integrator: args.integrator.clone(),
+    };
+    let session = Session::new(&desc, &overrides)?;
+    for w in &session.warnings {
+        eprintln!("{w}");
+    }
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(desc.output_name()));
+
+    let progress = interruptible_progress()?;
+    let pool = worker_pool(args.threads)?;
+    let show_bar = !args.quiet && std::io::stderr().is_terminal();
+    let output_data = std::thread::scope(|scope| {
+        let bar_done = Arc::new(std::sync::atomic::AtomicBool::new(false));
+        if show_bar {
+            let progress = Arc::clone(&progress);
+            let bar_done = Arc::clone(&bar_done);
+            scope.spawn(move || draw_progress(&progress, &bar_done));
+        }
+        let mut snapshot_errors = Vec::new();
+        let mut snapshot = |n: u32, film: &radiant::image::Film| {
+            if !args.snapshots {
+                return;
+            }
+            let path = snapshot_path(&output, n);
+            let meta = ImageMeta {
+                samples_per_pixel: Some(n),
+                render_time_seconds: None,
+                software: format!("radiant {}", env!("CARGO_PKG_VERSION")),
+            };
+            if let Err(e) = write_image(&path, &film.image(), &meta, args.exposure) {
+                snapshot_errors.push(format!("writing {}: {e}", path.display()));
+            }
+        };
+        let out = pool.install(|| session.render_with_snapshots(&progress, &mut snapshot));
+        bar_done.store(true, Ordering::SeqCst);
+        for e in snapshot_errors {
+            eprintln!("warning: {e}");
+        }
+        out
+    });
+
+    let meta = ImageMeta {
+        samples_per_pixel: Some(output_data.spp_done),
+        render_time_seconds: Some(output_data.seconds),
+        software: format!("radiant {}", env!("CARGO_PKG_VERSION")),
+    };
+    write_image(&output, &output_data.film.image(), &meta, args.exposure)
+        .with_context(|| format!("writing {}", output.display()))?;
+    let nf = output_data.film.nonfinite;
+    if nf.count > 0 {
+        let (x, y) = nf.first_pixel.unwrap_or((0, 0));
+        eprintln!(
+            "warning: {} non-finite sample(s) dropped (first at pixel {x},{y})",
+            nf.count
+        );
+    }
+    if !args.quiet {
+        let stats = output_data.stats.to_string();
+        for line in stats.lines() {
+            eprintln!("{line}");
+        }
+        eprintln!(
+            "{}: {}x{}, {} spp, {} integrator, {:.2} s, {:.2} Mrays/s",
+            output.display(),
+            session.ctx.resolution.0,
+            session.ctx.resolution.1,
+            output_data.spp_done,
+            session.integrator.name(),
+            output_data.seconds,
+            output_data.rays as f64 / output_data.seconds.max(1e-9) / 1e6
+        );
+    }
+    if output_data.interrupted {
+        bail!(
+            "interrupted: wrote the image so far ({} spp) to {}",
+            output_data.spp_done,
+            output.display()
+        );
+    }
+    Ok(())
+}
+
+/// `out.exr` → `out-00016.exr`.
+fn snapshot_path(output: &Path, n: u32) -> PathBuf {
+    let stem = output
+        .file_stem()
+        .map_or_else(|| "image".into(), |s| s.to_string_lossy().into_owned());
+    let name = match output.extension() {
+        Some(ext) => format!("{stem}-{n:05}.{}", ext.to_string_lossy()),
+        None => format!("{stem}-{n:05}"),
+    };
+    output.with_file_name(name)
+}
+
+/// Progress counters whose `cancel` flag Ctrl-C sets; the render then stops and the
+/// image so far is written. A second Ctrl-C (while that image is written) exits at once.
+pub fn interruptible_progress() -> anyhow::Result<Arc<Progress>> {
+    let progress = Arc::new(Progress::default());
+    let flag = Arc::clone(&progress);
+    ctrlc::set_handler(move || {
+        if flag.cancel.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    })
+    .context("installing the Ctrl-C handler")?;
+    Ok(progress)
+}
+
+/// The rayon pool for `--threads` (all cores when `None`).
+pub fn worker_pool(threads: Option<usize>) -> anyhow::Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .context("starting worker threads")
+}
+
+pub fn draw_progress(progress: &Progress, done: &std::sync::atomic::AtomicBool) {
+    let bar = indicatif::ProgressBar::new(progress.total.load(Ordering::Relaxed).max(1));
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {percent:>3}% samples {human_pos}/{human_len} {elapsed} ETA {eta} {msg}",
+        )
+        .expect("valid template"),
+    );
+    let start = std::time::Instant::now();
+    while !done.load(Ordering::SeqCst) {
+        std::thread::sleep(Duration::from_millis(200));
+        bar.set_length(progress.total.load(Ordering::Relaxed).max(1));
+        bar.set_position(progress.done.load(Ordering::Relaxed));
+        let mrays =
+            progress.rays.load(Ordering::Relaxed) as f64 / start.elapsed().as_secs_f64() / 1e6;
+        bar.set_message(format!("{mrays:.1} Mrays/s"));
+    }
+    bar.finish_and_clear();
+}

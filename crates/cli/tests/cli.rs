@@ -1,0 +1,221 @@
+//! The command line end to end: renders, bad input, determinism across thread counts,
+//! and Ctrl-C writing the image rendered so far.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use radiant::image::read_image;
+
+fn radiant() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_radiant"))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("radiant-cli-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(cmd: &mut Command) -> Output {
+    cmd.output().expect("radiant runs")
+}
+
+/// A panic exits with 101 and prints "panicked"; a handled error exits with 1.
+fn assert_clean_failure(out: &Output, what: &str) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(1), "{what}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{what} panicked: {stderr}");
+    stderr
+}
+
+#[test]
+fn renders_the_default_scene_to_every_format() {
+    let dir = temp_dir("formats");
+    for ext in ["exr", "pfm", "png"] {
+        let path = dir.join(format!("cb.{ext}"));
+        let out = run(radiant()
+            .args([
+                "render",
+                "--spp",
+                "2",
+                "--resolution",
+                "24x16",
+                "--quiet",
+                "-o",
+            ])
+            .arg(&path));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let img = read_image(&path).unwrap();
+        assert_eq!((img.width, img.height), (24, 16));
+        assert!(img.mean() > 0.0);
+    }
+}
+
+/// Every malformed scene of the parser's corpus exits non-zero with `file:line:column`
+/// and never panics.
+#[test]
+fn malformed_scenes_fail_cleanly_with_a_location() {
+    let corpus = radiant_testkit::repo_path("tests/scenes/malformed");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&corpus).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "pbrt") {
+            continue;
+        }
+        n += 1;
+        let out = run(radiant()
+            .args(["render", "--quiet", "-o", "/dev/null.exr"])
+            .arg(&path));
+        let stderr = assert_clean_failure(&out, &path.display().to_string());
+        let located = stderr.split_whitespace().any(|w| {
+            let parts: Vec<&str> = w.trim_end_matches(':').rsplitn(3, ':').collect();
+            parts.len() == 3 && parts[0].parse::<u32>().is_ok() && parts[1].parse::<u32>().is_ok()
+        });
+        assert!(
+            located,
+            "{}: no file:line:column in {stderr}",
+            path.display()
+        );
+    }
+    assert!(n >= 10, "corpus has {n} scenes");
+}
+
+#[test]
+fn missing_scene_and_bad_arguments_fail_cleanly() {
+    let out = run(radiant().args(["render", "no/such/scene.pbrt"]));
+    let stderr = assert_clean_failure(&out, "missing file");
+    assert!(stderr.contains("no/such/scene.pbrt"), "{stderr}");
+    let out = run(radiant().args(["render", "not-a-builtin"]));
+    assert_clean_failure(&out, "unknown scene name");
+    let out = run(radiant().args(["render", "--spp", "2", "--resolution", "8x8", "-o", "x.bmp"]));
+    assert_clean_failure(&out, "unknown extension");
+    let out = run(radiant().args(["render", "--integrator", "spmp", "--spp", "1"]));
+    let stderr = assert_clean_failure(&out, "unknown integrator");
+    assert!(stderr.contains("spmp"), "{stderr}");
+}
+
+/// The same scene, seed and spp give the same pixels, bit for bit, at 1 and 2 threads.
+/// (The EXR header's renderTimeSeconds is a measurement and differs; every pixel bit is
+/// compared, and the rest of the header too.)
+#[test]
+fn exr_is_bit_identical_at_one_and_two_threads() {
+    let dir = temp_dir("threads");
+    let render = |threads: &str| {
+        let path = dir.join(format!("t{threads}.exr"));
+        let out = run(radiant()
+            .args([
+                "render",
+                "cornell-caustics",
+                "--spp",
+                "4",
+                "--resolution",
+                "48x48",
+                "--quiet",
+            ])
+            .args(["--threads", threads, "-o"])
+            .arg(&path));
+        assert!(out.status.success());
+        path
+    };
+    let (a, b) = (render("1"), render("2"));
+    let (ia, ib) = (read_image(&a).unwrap(), read_image(&b).unwrap());
+    let bits = |i: &radiant::image::Image| -> Vec<u32> {
+        i.pixels
+            .iter()
+            .flat_map(|p| p.to_array().map(f32::to_bits))
+            .collect()
+    };
+    assert_eq!(bits(&ia), bits(&ib));
+}
+
+/// Ctrl-C (SIGINT) stops the render, writes the image so far and exits non-zero.
+#[cfg(unix)]
+#[test]
+fn interrupt_writes_the_partial_image() {
+    let dir = temp_dir("interrupt");
+    let path = dir.join("partial.exr");
+    let _ = std::fs::remove_file(&path);
+    let child = radiant()
+        .args([
+            "render",
+            "--spp",
+            "100000",
+            "--resolution",
+            "64x64",
+            "--quiet",
+            "-o",
+        ])
+        .arg(&path)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    let stderr = assert_clean_failure(&out, "interrupted render");
+    assert!(stderr.contains("interrupted"), "{stderr}");
+    let img = read_image(&path).unwrap();
+    assert!(img.mean() > 0.0, "partial image is empty");
+}
+
+/// `radiant radiosity --every K --sequence PATTERN` writes the classic progressive
+/// sequence: one numbered image per K shots, approaching the final image; `--every`
+/// alone is refused.
+#[test]
+fn radiosity_writes_the_progressive_sequence() {
+    let dir = temp_dir("radiosity-sequence");
+    let final_path = dir.join("final.pfm");
+    let out = run(radiant()
+        .args([
+            "radiosity",
+            "cornell-box",
+            "--tolerance",
+            "0.01",
+            "--resolution",
+            "16x16",
+            "--spp",
+            "4",
+            "--every",
+            "200",
+            "--quiet",
+            "--sequence",
+        ])
+        .arg(dir.join("frame-####.pfm"))
+        .arg("-o")
+        .arg(&final_path));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let frames: Vec<_> = (1..)
+        .map(|k| dir.join(format!("frame-{k:04}.pfm")))
+        .take_while(|p| p.exists())
+        .map(|p| read_image(&p).unwrap())
+        .collect();
+    assert!(frames.len() >= 2, "{} frames", frames.len());
+    let final_mean = read_image(&final_path).unwrap().mean();
+    assert!(final_mean > 0.0);
+    // Each frame shows B plus the ambient estimate of what is still unshot, so the
+    // frames close in on the solution as the unshot power falls.
+    let first = (frames[0].mean() / final_mean - 1.0).abs();
+    let last = (frames[frames.len() - 1].mean() / final_mean - 1.0).abs();
+    assert!(
+        frames
+            .iter()
+            .all(|f| f.pixels.iter().all(|p| p.is_finite()))
+    );
+    assert!(last < first, "first frame off by {first}, last by {last}");
+
+    let out = run(radiant().args(["radiosity", "cornell-box", "--every", "10", "--quiet"]));
+    let stderr = assert_clean_failure(&out, "--every without --sequence");
+    assert!(stderr.contains("--sequence"), "{stderr}");
+}

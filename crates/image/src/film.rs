@@ -1,0 +1,167 @@
+//! The film: per-pixel sums of filtered radiance samples.
+//!
+//! Pixel filtering is done by filter importance sampling: each camera sample is
+//! offset by a draw from the filter and counts, with the weight f/pdf, for the pixel it
+//! was generated for only. Pixels are therefore independent, rows can be rendered in
+//! parallel, and the sum in every pixel is taken in sample order — the same image at
+//! any thread count.
+//!
+//! The sensor (pbrt-v4's `PixelSensor`) is applied here and nowhere else: integrators
+//! accumulate scene radiance times the camera's weight, and every readout of the film
+//! — the image, snapshots, partial images — scales by the sensor's imaging ratio.
+
+use super::Image;
+use radiant_math::color::Rgb;
+
+/// Accumulated samples of one pixel (f64 sums: thousands of samples per pixel).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FilmPixel {
+    pub sum: [f64; 3],
+    pub weight: f64,
+    /// Samples taken, including dropped non-finite ones.
+    pub samples: u32,
+}
+
+impl FilmPixel {
+    pub fn add(&mut self, l: Rgb, weight: f32) {
+        self.sum[0] += (l.r * weight) as f64;
+        self.sum[1] += (l.g * weight) as f64;
+        self.sum[2] += (l.b * weight) as f64;
+        self.weight += weight as f64;
+        self.samples += 1;
+    }
+
+    /// A pixel holding an integrator's own estimate (SPPM's progressive statistics),
+    /// made from `samples` samples.
+    pub fn estimate(value: [f64; 3], samples: u32) -> FilmPixel {
+        FilmPixel {
+            sum: value,
+            weight: 1.0,
+            samples,
+        }
+    }
+
+    /// The weighted mean of the samples, before the sensor.
+    pub fn value(&self) -> Rgb {
+        if self.weight == 0.0 {
+            return Rgb::BLACK;
+        }
+        let inv = 1.0 / self.weight;
+        Rgb::new(
+            (self.sum[0] * inv) as f32,
+            (self.sum[1] * inv) as f32,
+            (self.sum[2] * inv) as f32,
+        )
+    }
+}
+
+/// Samples that were not finite, reported after the render (never written).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NonFinite {
+    pub count: u64,
+    /// The first pixel (in row-major order) that produced one.
+    pub first_pixel: Option<(u32, u32)>,
+}
+
+impl NonFinite {
+    pub fn merge(&mut self, other: NonFinite) {
+        self.count += other.count;
+        self.first_pixel = match (self.first_pixel, other.first_pixel) {
+            (Some(a), Some(b)) => Some(if (a.1, a.0) <= (b.1, b.0) { a } else { b }),
+            (a, b) => a.or(b),
+        };
+    }
+}
+
+/// The sensor's response: pbrt-v4's imaging ratio, exposure time × ISO / 100, which
+/// turns scene radiance into the recorded value (1 at ISO 100 and a 1 s shutter).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sensor {
+    pub imaging_ratio: f32,
+}
+
+impl Sensor {
+    /// ISO 100 and a one-second exposure: pixels record radiance as it is.
+    pub const UNIT: Sensor = Sensor { imaging_ratio: 1.0 };
+
+    pub fn new(iso: f32, exposure_time: f32) -> Sensor {
+        Sensor {
+            imaging_ratio: exposure_time * iso / 100.0,
+        }
+    }
+}
+
+impl Default for Sensor {
+    fn default() -> Self {
+        Sensor::UNIT
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Film {
+    pub width: usize,
+    pub height: usize,
+    pub pixels: Vec<FilmPixel>,
+    pub nonfinite: NonFinite,
+    pub sensor: Sensor,
+}
+
+impl Film {
+    pub fn new(width: usize, height: usize, sensor: Sensor) -> Film {
+        Film {
+            width,
+            height,
+            pixels: vec![FilmPixel::default(); width * height],
+            nonfinite: NonFinite::default(),
+            sensor,
+        }
+    }
+
+    /// The current estimate: each pixel's weighted mean, as the sensor records it.
+    pub fn image(&self) -> Image {
+        let ratio = self.sensor.imaging_ratio;
+        Image {
+            width: self.width,
+            height: self.height,
+            pixels: self.pixels.iter().map(|p| p.value() * ratio).collect(),
+        }
+    }
+
+    /// Samples taken in the pixel with the fewest (the image's guaranteed spp).
+    pub fn min_samples(&self) -> u32 {
+        self.pixels.iter().map(|p| p.samples).min().unwrap_or(0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pixel_value_is_the_weighted_mean() {
+        let mut p = FilmPixel::default();
+        p.add(Rgb::splat(1.0), 1.0);
+        p.add(Rgb::splat(4.0), 3.0);
+        assert_eq!(p.value(), Rgb::splat(13.0 / 4.0));
+        assert_eq!(FilmPixel::default().value(), Rgb::BLACK);
+    }
+
+    #[test]
+    fn first_nonfinite_pixel_is_the_earliest_in_row_order() {
+        let mut a = NonFinite {
+            count: 1,
+            first_pixel: Some((5, 2)),
+        };
+        a.merge(NonFinite {
+            count: 2,
+            first_pixel: Some((9, 1)),
+        });
+        assert_eq!(
+            a,
+            NonFinite {
+                count: 3,
+                first_pixel: Some((9, 1))
+            }
+        );
+    }
+}

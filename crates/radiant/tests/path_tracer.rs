@@ -1,0 +1,106 @@
+//! Path tracer physics: the white furnace, pbrt's analytic sphere, and determinism
+//! across thread counts.
+
+use glam::Vec3;
+use radiant::Session;
+use radiant::color::Rgb;
+use radiant::image::Image;
+use radiant::math::Transform;
+use radiant::render::{Overrides, Progress};
+use radiant::scene::builtin::{cornell_box, furnace};
+use radiant::scene::{Geometry, LightDesc, MaterialDesc, SceneDesc, ShapeDesc};
+
+fn render(desc: &SceneDesc, spp: u32, threads: usize) -> Image {
+    let session = Session::new(
+        desc,
+        &Overrides {
+            spp: Some(spp),
+            ..Default::default()
+        },
+    )
+    .expect("scene builds");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| session.render(&Progress::default()))
+        .film
+        .image()
+}
+
+/// Per-pixel statistics of one channel: mean over pixels and the spread between pixels.
+fn stats(img: &Image, channel: usize) -> (f64, f64) {
+    let v: Vec<f64> = img.pixels.iter().map(|p| p[channel] as f64).collect();
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    (mean, sd)
+}
+
+/// Every pixel of the furnace converges to Le / (1 - albedo) = 2. All pixels share one
+/// distribution, so the spread between pixels measures the per-pixel noise: each pixel
+/// must lie within 5 of those standard deviations of 2, and the image mean within 4
+/// standard errors.
+#[test]
+fn white_furnace_is_two_everywhere() {
+    let img = render(&furnace(), 16, 2);
+    for c in 0..3 {
+        let (mean, sd) = stats(&img, c);
+        let se = sd / (img.pixels.len() as f64).sqrt();
+        assert!(
+            (mean - 2.0).abs() < 4.0 * se + 1e-6,
+            "channel {c}: mean {mean}, se {se}"
+        );
+        for p in &img.pixels {
+            assert!(
+                (p[c] as f64 - 2.0).abs() < 5.0 * sd + 1e-6,
+                "pixel {p:?}, sd {sd}"
+            );
+        }
+    }
+}
+
+/// pbrt's analytic case: inside a unit sphere of Kd 0.5 with a point light of intensity
+/// pi at its centre, radiance is 1 everywhere (direct 0.5, then a geometric series).
+#[test]
+fn analytic_sphere_with_point_light_gives_radiance_one() {
+    let mut desc = furnace();
+    let ShapeDesc { geometry, .. } = &mut desc.shapes[0];
+    *geometry = Geometry::Sphere {
+        radius: 1.0,
+        z_min: -1.0,
+        z_max: 1.0,
+        phi_max_deg: 360.0,
+    };
+    desc.shapes[0].area_light = None;
+    desc.shapes[0].render_from_object = Transform::IDENTITY;
+    desc.materials = vec![MaterialDesc::Diffuse {
+        reflectance: Rgb::splat(0.5),
+    }];
+    desc.lights.push(LightDesc::Point {
+        position: Vec3::ZERO,
+        intensity: Rgb::splat(std::f32::consts::PI),
+        loc: desc.camera.loc.clone(),
+    });
+    let img = render(&desc, 16, 2);
+    let (mean, sd) = stats(&img, 1);
+    let se = sd / (img.pixels.len() as f64).sqrt();
+    assert!((mean - 1.0).abs() < 4.0 * se + 1e-6, "mean {mean}, se {se}");
+}
+
+/// The same scene, seed and sample count give the same image at any thread count.
+#[test]
+fn images_are_identical_at_one_and_two_threads() {
+    let mut desc = cornell_box();
+    desc.film.xresolution = 48;
+    desc.film.yresolution = 48;
+    let a = render(&desc, 4, 1);
+    let b = render(&desc, 4, 2);
+    assert!(
+        a.pixels
+            .iter()
+            .zip(&b.pixels)
+            .all(|(p, q)| p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits))
+    );
+    assert!(a.mean() > 0.0);
+}

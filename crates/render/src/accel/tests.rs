@@ -1,0 +1,343 @@
+//! BVH tests: every query must equal brute force over the same primitives.
+
+use super::displaced_sphere::geodesic_sphere;
+use super::{Bvh, TriangleBvh};
+use crate::geometry::triangle::{WatertightRay, intersect_triangle};
+use crate::geometry::{Aabb, Ray, Sphere};
+use glam::{Vec2, Vec3};
+use radiant_math::Transform;
+use radiant_math::hash::Pcg32;
+use radiant_math::sampling::uniform_sphere;
+
+fn rv(rng: &mut Pcg32) -> Vec3 {
+    Vec3::new(rng.uniform(), rng.uniform(), rng.uniform())
+}
+
+/// A soup mixing ordinary, axis-aligned, zero-area (collinear, coincident) and very thin
+/// triangles, with shared vertices and coordinates snapped to a coarse grid so that many
+/// rays pass exactly through edges and vertices and lie exactly in faces.
+fn soup(rng: &mut Pcg32, n: usize) -> Vec<[Vec3; 3]> {
+    let snap = |v: Vec3| (v * 8.0).round() / 8.0;
+    let mut tris = Vec::with_capacity(n);
+    for i in 0..n {
+        let c = rv(rng) * 10.0;
+        let p = [c + rv(rng) - 0.5, c + rv(rng) - 0.5, c + rv(rng) - 0.5].map(snap);
+        let t = match i % 6 {
+            0 => [p[0], p[1], 0.5 * (p[0] + p[1])],      // collinear
+            1 => [p[0], p[0], p[0]],                     // a point
+            2 => p.map(|v| Vec3::new(v.x, v.y, p[0].z)), // in a plane z = const
+            3 => [p[0], p[1], p[1] + Vec3::splat(1e-6)], // sliver
+            _ => p,
+        };
+        tris.push(t);
+    }
+    tris
+}
+
+/// Rays from random points towards random vertices, edge midpoints and random points,
+/// with some exactly axis-parallel directions and some in a face's plane.
+fn rays(rng: &mut Pcg32, tris: &[[Vec3; 3]], n: usize) -> Vec<Ray> {
+    (0..n)
+        .map(|i| {
+            let o = rv(rng) * 14.0 - Vec3::splat(2.0);
+            let t = tris[(rng.next_u32() as usize) % tris.len()];
+            let target = match i % 5 {
+                0 => t[0],
+                1 => 0.5 * (t[1] + t[2]),
+                2 => rv(rng) * 10.0,
+                3 => return Ray::new(t[0] - Vec3::X * 5.0 * rng.uniform(), Vec3::X), // along x
+                _ => return Ray::new(t[0] - (t[1] - t[0]), t[1] - t[0]), // in the face plane
+            };
+            Ray::new(o, target - o)
+        })
+        .collect()
+}
+
+fn brute_closest(tris: &[[Vec3; 3]], ray: &Ray, t_max: f32) -> Option<(f32, u32)> {
+    let wr = WatertightRay::new(ray);
+    let mut best: Option<(f32, u32)> = None;
+    for (i, t) in tris.iter().enumerate() {
+        let limit = best.map_or(t_max, |b| b.0);
+        if let Some(h) = intersect_triangle(&wr, t[0], t[1], t[2], limit) {
+            best = Some((h.t, i as u32));
+        }
+    }
+    best
+}
+
+fn tri_bounds(tris: &[[Vec3; 3]]) -> Vec<Aabb> {
+    tris.iter().map(|t| Aabb::from_points(t)).collect()
+}
+
+#[test]
+fn triangle_bvh_and_generic_bvh_equal_brute_force() {
+    let mut rng = Pcg32::new(42, 7);
+    let mut checked_hits = 0;
+    for (round, n) in [1usize, 2, 5, 17, 100, 1000, 3000].into_iter().enumerate() {
+        let tris = soup(&mut rng, n);
+        let tbvh = TriangleBvh::from_soup(&tris);
+        let bvh = Bvh::build(&tri_bounds(&tris));
+        assert_eq!(tbvh.triangle_count(), n);
+        for ray in rays(&mut rng, &tris, 1500) {
+            let wr = WatertightRay::new(&ray);
+            for t_max in [f32::INFINITY, 5.0 + round as f32] {
+                let expect = brute_closest(&tris, &ray, t_max);
+                let got = tbvh.intersect(&ray, t_max);
+                // Equal distances (bit-exact: same kernel); the triangle may differ on a tie.
+                assert_eq!(got.map(|h| h.t), expect.map(|e| e.0), "n={n} {ray:?}");
+                if let (Some(g), Some(e)) = (got, expect) {
+                    checked_hits += 1;
+                    let gp = tris[g.prim as usize];
+                    let again =
+                        intersect_triangle(&wr, gp[0], gp[1], gp[2], f32::INFINITY).unwrap();
+                    assert_eq!(again.t, e.0);
+                    assert_eq!(again.b, g.b);
+                }
+                let mut hit_prim = None;
+                let generic = bvh.closest_hit(&ray, t_max, |i, t_max| {
+                    let p = tris[i as usize];
+                    let h = intersect_triangle(&wr, p[0], p[1], p[2], t_max)?;
+                    hit_prim = Some(i);
+                    Some(h.t)
+                });
+                assert_eq!(generic, expect.map(|e| e.0));
+                assert_eq!(generic.is_some(), hit_prim.is_some());
+                let any = expect.is_some();
+                assert_eq!(tbvh.occluded(&ray, t_max), any);
+                let generic_any = bvh.any_hit(&ray, t_max, |i, t_max| {
+                    let p = tris[i as usize];
+                    intersect_triangle(&wr, p[0], p[1], p[2], t_max).is_some()
+                });
+                assert_eq!(generic_any, any);
+            }
+        }
+    }
+    assert!(checked_hits > 5000, "{checked_hits}");
+}
+
+#[test]
+fn closed_mesh_does_not_leak_through_the_bvh() {
+    // The watertight test survives the box culling (Ize's conservative exit distance):
+    // rays from inside a closed sphere towards its vertices and edge midpoints all hit.
+    let m = geodesic_sphere(12);
+    let bvh = TriangleBvh::build(&m.vertices, &m.triangles);
+    let mut rng = Pcg32::new(3, 3);
+    let mut misses = 0;
+    let mut n = 0;
+    for (k, t) in m.triangles.iter().enumerate() {
+        let o = (rv(&mut rng) - 0.5) * 0.8 * (k % 7) as f32 / 7.0;
+        let p = t.map(|i| m.vertices[i as usize]);
+        for target in [p[0], 0.5 * (p[0] + p[1]), 0.5 * (p[1] + p[2])] {
+            n += 1;
+            misses += usize::from(
+                bvh.intersect(&Ray::new(o, target - o), f32::INFINITY)
+                    .is_none(),
+            );
+            misses += usize::from(!bvh.occluded(&Ray::new(o, target - o), f32::INFINITY));
+        }
+    }
+    assert!(n > 8000);
+    assert_eq!(misses, 0);
+}
+
+#[test]
+fn generic_bvh_over_spheres_equals_brute_force() {
+    let mut rng = Pcg32::new(5, 9);
+    let spheres: Vec<(Vec3, f32)> = (0..500)
+        .map(|_| (rv(&mut rng) * 20.0, 0.05 + rng.uniform() * 0.6))
+        .collect();
+    let shape = |i: u32| {
+        let (c, r) = spheres[i as usize];
+        (c, Sphere::full(r).unwrap())
+    };
+    let bounds: Vec<Aabb> = spheres
+        .iter()
+        .map(|&(c, r)| Aabb::new(c - Vec3::splat(r), c + Vec3::splat(r)))
+        .collect();
+    let bvh = Bvh::build(&bounds);
+    let hit = |i: u32, ray: &Ray, t_max: f32| {
+        let (c, s) = shape(i);
+        s.intersect(&Ray::new(ray.o - c, ray.d), t_max).map(|h| h.t)
+    };
+    let mut hits = 0;
+    for _ in 0..3000 {
+        let o = rv(&mut rng) * 24.0 - Vec3::splat(2.0);
+        let ray = Ray::new(o, uniform_sphere(Vec2::new(rng.uniform(), rng.uniform())));
+        let brute = (0..spheres.len() as u32)
+            .filter_map(|i| hit(i, &ray, f32::INFINITY))
+            .min_by(f32::total_cmp);
+        let got = bvh.closest_hit(&ray, f32::INFINITY, |i, t| hit(i, &ray, t));
+        assert_eq!(got, brute);
+        assert_eq!(
+            bvh.any_hit(&ray, 8.0, |i, t| hit(i, &ray, t).is_some()),
+            brute.is_some_and(|t| t < 8.0)
+        );
+        hits += usize::from(got.is_some());
+    }
+    assert!(hits > 300, "{hits}");
+}
+
+#[test]
+fn two_level_instancing_matches_flattened_geometry() {
+    // Top level: a generic Bvh over instances; each instance's closure moves the ray into
+    // object space and traverses a shared TriangleBvh. The affine map keeps t unchanged
+    // (the direction is transformed, not renormalised), so t_max passes straight through.
+    let mut rng = Pcg32::new(8, 8);
+    let base = soup(&mut rng, 200);
+    let object = TriangleBvh::from_soup(&base);
+    let instances: Vec<Transform> = (0..40)
+        .map(|i| {
+            let offset = rv(&mut rng) * 60.0;
+            let spin = Transform::rotate(37.0 * i as f32, Vec3::new(1.0, 2.0, 0.5)).unwrap();
+            let scale = Transform::scale(Vec3::splat(0.5 + rng.uniform())).unwrap();
+            Transform::translate(offset).compose(&spin.compose(&scale))
+        })
+        .collect();
+    let world_bounds: Vec<Aabb> = instances
+        .iter()
+        .map(|x| {
+            let b = object.bounds();
+            let corners: Vec<Vec3> = (0..8)
+                .map(|c| {
+                    let pick = |bit: usize, lo: f32, hi: f32| if c & bit != 0 { hi } else { lo };
+                    x.point(Vec3::new(
+                        pick(1, b.min.x, b.max.x),
+                        pick(2, b.min.y, b.max.y),
+                        pick(4, b.min.z, b.max.z),
+                    ))
+                })
+                .collect();
+            Aabb::from_points(&corners)
+        })
+        .collect();
+    let top = Bvh::build(&world_bounds);
+    let flat: Vec<[Vec3; 3]> = instances
+        .iter()
+        .flat_map(|x| base.iter().map(move |t| t.map(|p| x.point(p))))
+        .collect();
+    let flat_bvh = TriangleBvh::from_soup(&flat);
+    let (mut hits, mut disagree, mut ties) = (0, 0, 0);
+    for _ in 0..10_000 {
+        let o = rv(&mut rng) * 80.0 - Vec3::splat(10.0);
+        let target =
+            instances[rng.next_u32() as usize % instances.len()].point(rv(&mut rng) * 10.0);
+        let ray = Ray::new(o, target - o);
+        let mut which = None;
+        let got = top.closest_hit(&ray, f32::INFINITY, |i, t_max| {
+            let inv = instances[i as usize].inverse();
+            let local = Ray::new(inv.point(ray.o), inv.vector(ray.d));
+            let h = object.intersect(&local, t_max)?;
+            which = Some((i, h.prim));
+            Some(h.t)
+        });
+        let expect = flat_bvh.intersect(&ray, f32::INFINITY);
+        match (got, expect) {
+            (Some(t), Some(e)) => {
+                hits += 1;
+                // Same surface up to the rounding of the transforms (~1e-5 relative).
+                assert!((t - e.t).abs() < 1e-4 * e.t, "{t} {}", e.t);
+                let (i, prim) = which.unwrap();
+                if i * 200 + prim != e.prim {
+                    // Only a near-tie between overlapping triangles may pick another one.
+                    disagree += 1;
+                    ties += usize::from((t - e.t).abs() < 1e-4 * e.t);
+                }
+            }
+            (None, None) => {}
+            // Transform rounding may flip a ray grazing an edge.
+            _ => disagree += 1,
+        }
+    }
+    assert!(hits > 800, "{hits}");
+    assert!(disagree * 100 < hits, "{disagree} of {hits} ({ties} ties)");
+}
+
+#[test]
+fn empty_and_degenerate_inputs() {
+    let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+    let empty = Bvh::build(&[]);
+    assert!(empty.closest_hit(&ray, 1.0, |_, _| Some(0.5)).is_none());
+    assert!(!empty.any_hit(&ray, 1.0, |_, _| true));
+    assert!(empty.bounds().is_empty());
+    let t = TriangleBvh::build(&[Vec3::ZERO], &[[0, 0, 5]]); // index out of range: left out
+    assert_eq!(t.triangle_count(), 0);
+    assert!(t.intersect(&ray, f32::INFINITY).is_none());
+    // Many identical boxes cannot be split by the SAH; the builder must still terminate
+    // and return every primitive.
+    let same = vec![Aabb::new(Vec3::ONE, Vec3::splat(2.0)); 10_000];
+    let bvh = Bvh::build(&same);
+    let mut seen = 0;
+    bvh.closest_hit(&Ray::new(Vec3::ZERO, Vec3::ONE), f32::INFINITY, |_, _| {
+        seen += 1;
+        None
+    });
+    assert_eq!(seen, 10_000);
+    let mut order = bvh.prim_order().to_vec();
+    order.sort_unstable();
+    assert!(order.iter().enumerate().all(|(k, &p)| k as u32 == p));
+}
+
+#[test]
+fn deep_trees_use_the_large_stack_and_stay_exact() {
+    // A hand-made worst case for the traversal stack: a chain of 30 wide nodes whose boxes
+    // all enclose the whole scene, each with one inner child and WIDTH − 1 leaves, so a ray
+    // pushes WIDTH − 1 entries per level. The small stack would overflow; the tree must be
+    // recognised as deep and still answer exactly.
+    use super::node::{WIDTH, WideNode, encode_leaf};
+    let levels = 30;
+    let per_level = WIDTH - 1;
+    let mut rng = Pcg32::new(77, 1);
+    let spheres: Vec<(Vec3, f32)> = (0..levels * per_level)
+        .map(|_| (rv(&mut rng), 0.02 + 0.05 * rng.uniform()))
+        .collect();
+    let all = Aabb::new(Vec3::splat(-1.0), Vec3::splat(2.0));
+    let nodes: Vec<WideNode> = (0..levels)
+        .map(|level| {
+            let mut node = WideNode::empty();
+            for k in 0..per_level {
+                node.set_child(k, &all, encode_leaf((level * per_level + k) as u32, 1));
+            }
+            if level + 1 < levels {
+                node.set_child(per_level, &all, level as u32 + 1);
+            }
+            node
+        })
+        .collect();
+    let order: Vec<u32> = (0..spheres.len() as u32).collect();
+    let bvh = Bvh::from_parts(nodes, order, all);
+    assert!(!bvh.nodes_are_shallow());
+    let hit = |i: u32, ray: &Ray, t_max: f32| {
+        let (c, r) = spheres[i as usize];
+        Sphere::full(r)
+            .unwrap()
+            .intersect(&Ray::new(ray.o - c, ray.d), t_max)
+            .map(|h| h.t)
+    };
+    let mut hits = 0;
+    for _ in 0..500 {
+        let o = Vec3::new(-0.5, rng.uniform(), rng.uniform());
+        let ray = Ray::new(o, rv(&mut rng) - o);
+        let brute = (0..spheres.len() as u32)
+            .filter_map(|i| hit(i, &ray, f32::INFINITY))
+            .min_by(f32::total_cmp);
+        assert_eq!(
+            bvh.closest_hit(&ray, f32::INFINITY, |i, t| hit(i, &ray, t)),
+            brute
+        );
+        let mut visited = 0;
+        let any = bvh.any_hit(&ray, f32::INFINITY, |i, t| {
+            visited += 1;
+            hit(i, &ray, t).is_some()
+        });
+        assert_eq!(any, brute.is_some());
+        if !any {
+            assert_eq!(
+                visited,
+                spheres.len(),
+                "a miss must test every primitive here"
+            );
+        }
+        hits += usize::from(brute.is_some());
+    }
+    assert!(hits > 100, "{hits}");
+}

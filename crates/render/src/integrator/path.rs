@@ -1,0 +1,221 @@
+//! The path tracer: radiance by random walks from the camera with next-event estimation
+//! and multiple importance sampling (Veach & Guibas 1995, power heuristic), Russian
+//! roulette and specular chains. An iterative loop carrying a throughput — no recursion.
+
+use glam::Vec3;
+
+use crate::geometry::Ray;
+use crate::light::Light;
+use crate::material::{Material, TransportMode};
+use crate::sampler::PixelSample;
+use crate::world::{NO_LIGHT, World};
+use radiant_math::color::Rgb;
+use radiant_math::{Frame, sampling::power_heuristic};
+use radiant_scene::{IntegratorDesc, SceneError};
+
+use super::direct;
+use super::{Integrator, PixelEstimator, PixelId, RenderControl, RenderOutput, render_passes};
+use crate::context::RenderContext;
+
+/// `Integrator "path"` parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathSettings {
+    /// `"integer maxdepth" [5]`: the number of bounces; emission seen after the last
+    /// bounce still counts.
+    pub max_depth: u32,
+    /// Bounces before Russian roulette may end a path (pbrt-v4 starts after 1).
+    pub rr_depth: u32,
+}
+
+impl PathSettings {
+    pub fn from_desc(desc: &IntegratorDesc) -> Result<PathSettings, SceneError> {
+        Ok(PathSettings {
+            max_depth: desc.params.count("maxdepth", 5)?,
+            rr_depth: desc.params.count("rrdepth", 1)?,
+        })
+    }
+}
+
+impl Default for PathSettings {
+    fn default() -> Self {
+        PathSettings {
+            max_depth: 5,
+            rr_depth: 1,
+        }
+    }
+}
+
+/// The path tracer as an integrator: one path per pixel sample through the pass loop.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathIntegrator {
+    pub settings: PathSettings,
+}
+
+impl Integrator for PathIntegrator {
+    fn name(&self) -> &'static str {
+        "path"
+    }
+
+    fn render(&self, ctx: &RenderContext, control: &mut RenderControl<'_>) -> RenderOutput {
+        render_passes(
+            ctx,
+            &PathEstimator {
+                world: &ctx.world,
+                settings: &self.settings,
+            },
+            control,
+        )
+    }
+}
+
+struct PathEstimator<'a> {
+    world: &'a World,
+    settings: &'a PathSettings,
+}
+
+impl PixelEstimator for PathEstimator<'_> {
+    type Scratch = ();
+
+    fn scratch(&self) {}
+
+    fn radiance(
+        &self,
+        ray: Ray,
+        sampler: &mut PixelSample,
+        _pixel: PixelId,
+        _scratch: &mut (),
+    ) -> (Rgb, u32) {
+        radiance(self.world, self.settings, ray, sampler)
+    }
+}
+
+/// Radiance along a camera ray; also returns the number of rays traced.
+pub fn radiance(
+    world: &World,
+    settings: &PathSettings,
+    mut ray: Ray,
+    sampler: &mut PixelSample,
+) -> (Rgb, u32) {
+    let scene = world.scene_sphere();
+    let mut l = Rgb::BLACK;
+    let mut beta = Rgb::WHITE;
+    // Product of eta^2 scalings at refractions, undone for Russian roulette decisions.
+    let mut eta_scale = 1.0f32;
+    let mut specular_bounce = true;
+    let mut prev_pdf = 0.0f32;
+    let mut prev_p = ray.o;
+    let mut rays = 0u32;
+    let mut depth = 0u32;
+    loop {
+        rays += 1;
+        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+            for (i, light) in world.lights.iter().enumerate() {
+                let le = light.environment(ray.d);
+                if le.is_black() {
+                    continue;
+                }
+                let w = if specular_bounce {
+                    1.0
+                } else {
+                    let pdf_light = world.light_distribution.pmf(i)
+                        * light.pdf_li(prev_p, Vec3::ZERO, Vec3::ZERO, glam::Vec2::ZERO);
+                    power_heuristic(prev_pdf, pdf_light)
+                };
+                l += beta * le * w;
+            }
+            break;
+        };
+        let wo_world = -ray.d.normalize();
+        if hit.light != NO_LIGHT {
+            let Light::Area(area) = &world.lights[hit.light as usize] else {
+                unreachable!("primitives only carry area lights")
+            };
+            let le = area.radiance(hit.ng, wo_world);
+            if !le.is_black() {
+                let w = if specular_bounce {
+                    1.0
+                } else {
+                    let pdf_light = world.light_distribution.pmf(hit.light as usize)
+                        * area.pdf_li(prev_p, hit.p, hit.ng, hit.uv);
+                    power_heuristic(prev_pdf, pdf_light)
+                };
+                l += beta * le * w;
+            }
+        }
+        if depth == settings.max_depth {
+            break;
+        }
+        depth += 1;
+
+        let material = world.materials[hit.material as usize];
+        let frame = Frame::from_normal(hit.ns);
+        let wo = frame.to_local(wo_world);
+
+        // Drawn for every vertex so that the dimension layout does not depend on the material.
+        let u_choice = sampler.get_1d();
+        let u_light = sampler.get_2d();
+        if !material.is_specular() {
+            let mut shadow_rays = 0;
+            let ds = direct::sample_direct(
+                world,
+                scene,
+                &hit,
+                &material,
+                &frame,
+                wo,
+                wo_world,
+                u_choice,
+                u_light,
+                &mut shadow_rays,
+            );
+            rays += shadow_rays;
+            if let Some(ds) = ds {
+                let w = if ds.delta {
+                    1.0
+                } else {
+                    power_heuristic(ds.light_pdf, ds.bsdf_pdf)
+                };
+                l += beta * ds.f * ds.li * (w / ds.light_pdf);
+            }
+        }
+
+        let u_lobe = sampler.get_1d();
+        let u_dir = sampler.get_2d();
+        let Some(bs) = material.sample(wo, u_lobe, u_dir, TransportMode::Radiance) else {
+            break;
+        };
+        let wi = frame.to_world(bs.wi);
+        if !bs.specular && wi.dot(hit.ng) * wo_world.dot(hit.ng) <= 0.0 {
+            break;
+        }
+        beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
+        if let Material::Dielectric { eta } = material
+            && wi.dot(hit.ng) * wo_world.dot(hit.ng) < 0.0
+        {
+            // Refraction: track eta^2 so roulette sees the unscaled throughput.
+            eta_scale *= if wo_world.dot(hit.ng) > 0.0 {
+                eta * eta
+            } else {
+                1.0 / (eta * eta)
+            };
+        }
+        specular_bounce = bs.specular;
+        prev_pdf = bs.pdf;
+        prev_p = hit.p;
+        ray = hit.spawn_ray(wi);
+
+        let u_rr = sampler.get_1d();
+        let rr_beta = beta.max_component() * eta_scale;
+        if depth > settings.rr_depth && rr_beta < 1.0 {
+            let q = (1.0 - rr_beta).max(0.0);
+            if u_rr < q {
+                break;
+            }
+            beta /= 1.0 - q;
+        }
+        if beta.is_black() {
+            break;
+        }
+    }
+    (l, rays)
+}

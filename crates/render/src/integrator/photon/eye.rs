@@ -1,0 +1,260 @@
+//! Camera paths of the photon mapper: specular chains by ray tracing, then at the first
+//! diffuse point direct light (next-event estimation), caustics (caustic map) and
+//! indirect light (final gathering), or one of the visualisations.
+
+use glam::Vec3;
+
+use super::estimate::{EstimatePoint, radiance_estimate};
+use super::kdtree::Neighbors;
+use super::record::FIRST_DIFFUSE;
+use super::settings::Visualize;
+use super::{PhotonMaps, facing};
+use crate::geometry::Ray;
+use crate::integrator::direct::{environment, sample_direct, surface_emission};
+use crate::integrator::specular::specular_bounce;
+use crate::light::SceneSphere;
+use crate::material::{Material, TransportMode};
+use crate::sampler::PixelSample;
+use crate::world::{SurfaceHit, World};
+use radiant_math::color::Rgb;
+use radiant_math::{Frame, INV_PI};
+use radiant_scene::SamplerKind;
+
+/// Per-thread buffers for lookups, so that camera paths do not allocate.
+#[derive(Clone, Debug)]
+pub struct EyeScratch {
+    caustic: Neighbors,
+    global: Neighbors,
+    nearest: Neighbors,
+}
+
+impl EyeScratch {
+    /// Buffers sized for the lookups `maps` makes.
+    pub fn new(maps: &PhotonMaps) -> EyeScratch {
+        EyeScratch {
+            caustic: Neighbors::new(maps.settings.lookup as usize),
+            global: Neighbors::new(maps.settings.global_lookup as usize),
+            nearest: Neighbors::new(1),
+        }
+    }
+}
+
+/// Where the random numbers of the final-gather rays of one camera sample come from:
+/// gather ray `j` is sample `j` of a stream named by `key`, so the rays of one camera
+/// sample are stratified together.
+#[derive(Clone, Copy, Debug)]
+pub struct GatherStream {
+    pub kind: SamplerKind,
+    pub seed: u64,
+    pub key: u64,
+}
+
+/// Everything a camera path needs besides its ray.
+pub struct EyeContext<'a> {
+    pub world: &'a World,
+    pub maps: &'a PhotonMaps,
+    pub scene: SceneSphere,
+    /// Angle subtended by one pixel (for the photon dots of `visualize "photons"`).
+    pub pixel_angle: f32,
+}
+
+/// Radiance along a camera ray, and the number of rays traced.
+pub fn radiance(
+    ctx: &EyeContext,
+    mut ray: Ray,
+    sampler: &mut PixelSample,
+    gather: GatherStream,
+    scratch: &mut EyeScratch,
+) -> (Rgb, u32) {
+    let world = ctx.world;
+    let settings = &ctx.maps.settings;
+    let mut l = Rgb::BLACK;
+    let mut beta = Rgb::WHITE;
+    let mut rays = 0u32;
+    let mut travelled = 0.0f32;
+    for depth in 0..=settings.max_depth {
+        rays += 1;
+        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+            l += beta * environment(world, ray.d);
+            break;
+        };
+        travelled += hit.t * ray.d.length();
+        let wo_world = -ray.d.normalize();
+        let emitted = surface_emission(world, &hit, wo_world);
+        let material = world.materials[hit.material as usize];
+        if material.is_specular() {
+            // The camera sees emitters directly or through specular chains only.
+            l += beta * emitted;
+            if depth == settings.max_depth {
+                break;
+            }
+            let frame = Frame::from_normal(hit.ns);
+            let wo = frame.to_local(wo_world);
+            let Some(wi) = specular_bounce(&material, &frame, wo, sampler, &mut beta) else {
+                break;
+            };
+            ray = hit.spawn_ray(wi);
+            continue;
+        }
+        let at = EstimatePoint {
+            p: hit.p,
+            n: facing(hit.ng, wo_world),
+        };
+        let frame = Frame::from_normal(hit.ns);
+        let wo = frame.to_local(wo_world);
+        let bsdf = |wi: Vec3| material.eval(wo, frame.to_local(wi));
+        let maps = ctx.maps;
+        // Radiance reflected towards the viewer by the photons of one map near the point.
+        let estimate = |map, skip_flags, neighbours: &mut _| {
+            radiance_estimate(
+                map,
+                &at,
+                maps.max_r2,
+                settings.kernel,
+                skip_flags,
+                neighbours,
+                bsdf,
+            )
+        };
+        let reflected = match settings.visualize {
+            Visualize::None => {
+                l += beta * emitted;
+                let u_choice = sampler.get_1d();
+                let u_light = sampler.get_2d();
+                let direct = sample_direct(
+                    world, ctx.scene, &hit, &material, &frame, wo, wo_world, u_choice, u_light,
+                    &mut rays,
+                )
+                .map_or(Rgb::BLACK, |d| d.unweighted());
+                let caustic = estimate(&maps.caustic, 0, &mut scratch.caustic);
+                let indirect = if settings.final_gather_samples > 0 {
+                    final_gather(
+                        ctx, &hit, &material, &frame, wo, wo_world, gather, scratch, &mut rays,
+                    )
+                } else {
+                    estimate(&maps.global, 0, &mut scratch.global)
+                };
+                direct + caustic + indirect
+            }
+            Visualize::Caustic => estimate(&maps.caustic, 0, &mut scratch.caustic),
+            Visualize::Global => estimate(&maps.global, FIRST_DIFFUSE, &mut scratch.global),
+            Visualize::Density => {
+                l += beta * emitted;
+                estimate(&maps.global, 0, &mut scratch.global)
+                    + estimate(&maps.caustic, 0, &mut scratch.caustic)
+            }
+            Visualize::Photons => photon_dots(maps, &at, 0.75 * ctx.pixel_angle * travelled),
+        };
+        l += beta * reflected;
+        break;
+    }
+    (l, rays)
+}
+
+/// Stored photons within `radius` of the point, each drawn in its normalised colour.
+fn photon_dots(maps: &PhotonMaps, at: &EstimatePoint, radius: f32) -> Rgb {
+    let mut sum = Rgb::BLACK;
+    for map in [&maps.global, &maps.caustic] {
+        map.tree().within(at.p, radius * radius, |_, ph, _| {
+            if ph.normal().dot(at.n) > 0.7 {
+                let c = map.power(ph);
+                sum += c * (1.0 / c.max_component().max(1e-30));
+            }
+        });
+    }
+    sum
+}
+
+/// Indirect diffuse light at a camera path's diffuse point by final gathering: rays
+/// sampled from the BSDF follow specular chains to a diffuse point y, where the light
+/// leaving y is next-event estimation plus the precomputed irradiance (global and
+/// caustic maps) times the diffuse reflectance. Emission reached by gather rays is not
+/// counted (next-event estimation and the caustic map at the camera path's point hold
+/// those paths).
+#[allow(clippy::too_many_arguments)]
+fn final_gather(
+    ctx: &EyeContext,
+    x: &SurfaceHit,
+    material: &Material,
+    frame: &Frame,
+    wo: Vec3,
+    wo_world: Vec3,
+    gather: GatherStream,
+    scratch: &mut EyeScratch,
+    rays: &mut u32,
+) -> Rgb {
+    let world = ctx.world;
+    let maps = ctx.maps;
+    let settings = &maps.settings;
+    let n = settings.final_gather_samples;
+    let mut sum = Rgb::BLACK;
+    for j in 0..n {
+        let mut s = PixelSample::for_stream(gather.kind, gather.seed, gather.key, j);
+        let u_lobe = s.get_1d();
+        let u_dir = s.get_2d();
+        let Some(bs) = material.sample(wo, u_lobe, u_dir, TransportMode::Radiance) else {
+            continue;
+        };
+        let wi = frame.to_world(bs.wi);
+        if !bs.specular && wi.dot(x.ng) * wo_world.dot(x.ng) <= 0.0 {
+            continue;
+        }
+        let mut beta = bs.f * (bs.wi.z.abs() / bs.pdf);
+        let mut ray = x.spawn_ray(wi);
+        for _ in 0..settings.max_depth {
+            *rays += 1;
+            let Some(y) = world.intersect(&ray, f32::INFINITY) else {
+                break;
+            };
+            let mat_y = world.materials[y.material as usize];
+            let wo_y_world = -ray.d.normalize();
+            let frame_y = Frame::from_normal(y.ns);
+            let wo_y = frame_y.to_local(wo_y_world);
+            if mat_y.is_specular() {
+                let Some(wi) = specular_bounce(&mat_y, &frame_y, wo_y, &mut s, &mut beta) else {
+                    break;
+                };
+                ray = y.spawn_ray(wi);
+                continue;
+            }
+            let u_choice = s.get_1d();
+            let u_light = s.get_2d();
+            let direct = sample_direct(
+                world, ctx.scene, &y, &mat_y, &frame_y, wo_y, wo_y_world, u_choice, u_light, rays,
+            )
+            .map_or(Rgb::BLACK, |d| d.unweighted());
+            let at = EstimatePoint {
+                p: y.p,
+                n: facing(y.ng, wo_y_world),
+            };
+            let irradiance = maps
+                .irradiance
+                .as_ref()
+                .and_then(|c| c.lookup(&at, maps.max_r2, &mut scratch.nearest))
+                .unwrap_or_else(|| {
+                    // No precomputed point nearby: estimate irradiance here.
+                    let one = |_| Rgb::WHITE;
+                    radiance_estimate(
+                        &maps.global,
+                        &at,
+                        maps.max_r2,
+                        settings.kernel,
+                        0,
+                        &mut scratch.global,
+                        one,
+                    ) + radiance_estimate(
+                        &maps.caustic,
+                        &at,
+                        maps.max_r2,
+                        settings.kernel,
+                        0,
+                        &mut scratch.caustic,
+                        one,
+                    )
+                });
+            sum += beta * (direct + irradiance * mat_y.diffuse_albedo() * INV_PI);
+            break;
+        }
+    }
+    sum * (1.0 / n.max(1) as f32)
+}

@@ -1,0 +1,117 @@
+//! The camera pass of an SPPM iteration: one camera ray per pixel, followed through
+//! specular chains to the first diffuse point, where a visible point is left for the
+//! photons (Hachisuka & Jensen 2009: a new random visible point per iteration makes
+//! the method stochastic and the pixel estimate converge to the pixel's integral, not
+//! to one point's radiance).
+//!
+//! Direct light is computed here, by next-event estimation at the visible point (as
+//! pbrt-v4 does), together with emission seen through the specular chain; photons then
+//! only carry indirect light (they are not deposited at their first hit).
+
+use glam::Vec3;
+
+use crate::context::RenderContext;
+use crate::integrator::direct::{environment, sample_direct, surface_emission};
+use crate::integrator::specular::specular_bounce;
+use radiant_math::Frame;
+use radiant_math::color::Rgb;
+
+/// A camera path's first diffuse point this iteration.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct VisiblePoint {
+    pub p: Vec3,
+    /// Geometric normal turned towards the camera path.
+    pub n: Vec3,
+    /// Shading normal (the BSDF frame).
+    pub ns: Vec3,
+    /// Direction to the camera, in the shading frame.
+    pub wo: Vec3,
+    /// Camera path throughput (camera weight, filter weight, specular chain).
+    pub beta: Rgb,
+    pub material: u32,
+    pub valid: bool,
+}
+
+/// What a pixel's camera sample found: direct light and a visible point.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CameraSample {
+    pub ld: Rgb,
+    pub vp: VisiblePoint,
+    pub rays: u32,
+}
+
+/// Traces the camera sample of pixel `(x, y)` for `iteration`.
+pub fn camera_sample(
+    ctx: &RenderContext,
+    seed: u64,
+    max_depth: u32,
+    x: u32,
+    y: u32,
+    iteration: u32,
+) -> CameraSample {
+    let world = &ctx.world;
+    let scene = world.scene_sphere();
+    let mut out = CameraSample::default();
+    let mut sampler = ctx.pixel_sample(seed, x, y, iteration);
+    let cs = ctx.camera_sample(&mut sampler, x, y);
+    let Some(cr) = cs.ray else {
+        return out;
+    };
+    let mut ray = cr.ray;
+    // The sensor is the film's; the camera path starts with the camera's weight.
+    let mut beta = Rgb::splat(cr.weight * cs.filter_weight);
+    for depth in 0..=max_depth {
+        out.rays += 1;
+        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+            out.ld += beta * environment(world, ray.d);
+            break;
+        };
+        let wo_world = -ray.d.normalize();
+        // Only specular vertices precede this one: emission always counts.
+        out.ld += beta * surface_emission(world, &hit, wo_world);
+        let material = world.materials[hit.material as usize];
+        let frame = Frame::from_normal(hit.ns);
+        let wo = frame.to_local(wo_world);
+        if material.is_specular() {
+            if depth == max_depth {
+                break;
+            }
+            let Some(wi) = specular_bounce(&material, &frame, wo, &mut sampler, &mut beta) else {
+                break;
+            };
+            ray = hit.spawn_ray(wi);
+            continue;
+        }
+        let u_choice = sampler.get_1d();
+        let u_light = sampler.get_2d();
+        if let Some(d) = sample_direct(
+            world,
+            scene,
+            &hit,
+            &material,
+            &frame,
+            wo,
+            wo_world,
+            u_choice,
+            u_light,
+            &mut out.rays,
+        ) {
+            out.ld += beta * d.unweighted();
+        }
+        out.vp = VisiblePoint {
+            p: hit.p,
+            n: if hit.ng.dot(wo_world) >= 0.0 {
+                hit.ng
+            } else {
+                -hit.ng
+            },
+            ns: hit.ns,
+            wo,
+            beta,
+            material: hit.material,
+            valid: true,
+        };
+        break;
+    }
+    out
+}

@@ -1,0 +1,18 @@
+//! Rendering: geometry and acceleration, materials, lights, cameras, samplers and the
+//! integrators that turn a scene into film samples.
+
+#![forbid(unsafe_code)]
+
+pub mod accel;
+pub mod bench;
+pub mod camera;
+pub mod context;
+pub mod geometry;
+pub mod integrator;
+pub mod light;
+pub mod material;
+pub mod sampler;
+pub mod world;
+
+pub use context::{CameraSample, Overrides, Progress, RenderContext};
+pub use integrator::{Integrator, RenderControl, RenderOutput, Stats};

@@ -1,0 +1,225 @@
+//! Diffuse area lights: a shape that emits radiance `l` from its front side (or both
+//! sides). Each emitting primitive — one triangle, one sphere — is its own light, so
+//! lights can be chosen in proportion to their power.
+
+use glam::{Vec2, Vec3};
+
+use super::{EmittedRay, LightSample};
+use crate::geometry::Ray;
+use crate::geometry::bilinear::BilinearPatch;
+use crate::geometry::disk::Disk;
+use crate::geometry::ray::offset_origin;
+use crate::geometry::sample::{AreaSample, area_pdf_to_solid_angle};
+use crate::geometry::sphere::Sphere;
+use crate::geometry::triangle::sample_triangle;
+use radiant_math::color::Rgb;
+use radiant_math::{Frame, PI, Transform, sampling};
+
+#[derive(Clone, Debug)]
+pub enum LightShape {
+    /// A triangle in render space; `n` is the oriented front normal.
+    Triangle { p: [Vec3; 3], n: Vec3, area: f32 },
+    /// A sphere placed by a similarity transform (solid angles are preserved).
+    Sphere {
+        sphere: Sphere,
+        render_from_object: Transform,
+        reverse: bool,
+    },
+    /// A curved bilinear patch in render space; `orientation` −1 flips ∂p/∂u × ∂p/∂v.
+    Bilinear {
+        patch: BilinearPatch,
+        orientation: f32,
+    },
+    /// A disk placed by a similarity transform; `scale2` is the area scale factor.
+    Disk {
+        disk: Disk,
+        render_from_object: Transform,
+        reverse: bool,
+        scale2: f32,
+    },
+}
+
+#[derive(Clone, Debug)]
+pub struct AreaLight {
+    pub shape: LightShape,
+    pub l: Rgb,
+    pub two_sided: bool,
+}
+
+impl AreaLight {
+    pub fn area(&self) -> f32 {
+        match &self.shape {
+            LightShape::Triangle { area, .. } => *area,
+            LightShape::Sphere {
+                sphere,
+                render_from_object,
+                ..
+            } => sphere.area() * similarity_scale2(render_from_object),
+            LightShape::Disk { disk, scale2, .. } => disk.area() * scale2,
+            LightShape::Bilinear { patch, .. } => patch.area(),
+        }
+    }
+
+    pub fn power(&self) -> Rgb {
+        let sides = if self.two_sided { 2.0 } else { 1.0 };
+        self.l * (PI * self.area() * sides)
+    }
+
+    /// Radiance leaving a point with front normal `n` in direction `w`.
+    pub fn radiance(&self, n: Vec3, w: Vec3) -> Rgb {
+        if self.two_sided || n.dot(w) > 0.0 {
+            self.l
+        } else {
+            Rgb::BLACK
+        }
+    }
+
+    /// A point on the light sampled uniformly by render-space area.
+    fn sample_area(&self, u: Vec2) -> Option<AreaSample> {
+        match &self.shape {
+            LightShape::Triangle { p, n, area } => {
+                let s = sample_triangle(p[0], p[1], p[2], u)?;
+                Some(AreaSample {
+                    p: s.p,
+                    n: *n,
+                    pdf: 1.0 / area,
+                })
+            }
+            LightShape::Sphere {
+                sphere,
+                render_from_object,
+                reverse,
+            } => {
+                let s = sphere.sample_area(u);
+                Some(to_render(
+                    s,
+                    render_from_object,
+                    *reverse,
+                    similarity_scale2(render_from_object),
+                ))
+            }
+            LightShape::Disk {
+                disk,
+                render_from_object,
+                reverse,
+                scale2,
+            } => Some(to_render(
+                disk.sample_area(u),
+                render_from_object,
+                *reverse,
+                *scale2,
+            )),
+            LightShape::Bilinear { patch, orientation } => {
+                let s = patch.sample_area(u)?;
+                Some(AreaSample {
+                    n: s.n * *orientation,
+                    ..s
+                })
+            }
+        }
+    }
+
+    pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+        let (q, n, pdf) = match &self.shape {
+            // Spheres: sample the cone they subtend (far less variance than area sampling).
+            LightShape::Sphere {
+                sphere,
+                render_from_object,
+                reverse,
+            } => {
+                let inv = render_from_object.inverse();
+                let s = sphere.sample_solid_angle(inv.point(p), u)?;
+                let mut n = render_from_object.normal(s.n).normalize();
+                if *reverse {
+                    n = -n;
+                }
+                (render_from_object.point(s.p), n, s.pdf)
+            }
+            _ => {
+                let s = self.sample_area(u)?;
+                (s.p, s.n, area_pdf_to_solid_angle(s.pdf, p, s.p, s.n))
+            }
+        };
+        if pdf <= 0.0 || !pdf.is_finite() {
+            return None;
+        }
+        let wi = (q - p).normalize_or_zero();
+        let li = self.radiance(n, -wi);
+        if li.is_black() || wi == Vec3::ZERO {
+            return None;
+        }
+        Some(LightSample {
+            li,
+            wi,
+            p: q,
+            n,
+            pdf,
+            delta: false,
+            at_infinity: false,
+        })
+    }
+
+    /// Solid-angle density of `sample_li` from `p` for the light point `q` (normal `n`,
+    /// surface parameters `uv`).
+    pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3, uv: Vec2) -> f32 {
+        match &self.shape {
+            LightShape::Sphere {
+                sphere,
+                render_from_object,
+                ..
+            } => {
+                let inv = render_from_object.inverse();
+                sphere.pdf_solid_angle(inv.point(p), inv.point(q))
+            }
+            LightShape::Bilinear { patch, .. } => {
+                area_pdf_to_solid_angle(patch.pdf_area(uv), p, q, n)
+            }
+            _ => area_pdf_to_solid_angle(1.0 / self.area(), p, q, n),
+        }
+    }
+
+    /// A photon ray: uniform position by area, cosine-distributed direction on the
+    /// emitting side(s). Its power is L π A (one side) — the light's whole power.
+    pub fn sample_emission(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmittedRay> {
+        let s = self.sample_area(u_pos)?;
+        let (mut u, mut n) = (u_dir, s.n);
+        let mut sides = 1.0;
+        if self.two_sided {
+            sides = 2.0;
+            // Reuse the first dimension to pick the side.
+            if u.x < 0.5 {
+                u.x *= 2.0;
+            } else {
+                u.x = 2.0 * u.x - 1.0;
+                n = -n;
+            }
+            u.x = u.x.min(radiant_math::ONE_MINUS_EPSILON);
+        }
+        let d = Frame::from_normal(n).to_world(sampling::cosine_hemisphere(u));
+        Some(EmittedRay {
+            ray: Ray::new(offset_origin(s.p, n, d), d),
+            n,
+            power: self.l * (PI * sides / s.pdf),
+        })
+    }
+}
+
+/// Area scale factor of a similarity transform: |det|^(2/3).
+fn similarity_scale2(xf: &Transform) -> f32 {
+    glam::Mat3::from_mat4(xf.m)
+        .determinant()
+        .abs()
+        .powf(2.0 / 3.0)
+}
+
+fn to_render(s: AreaSample, xf: &Transform, reverse: bool, scale2: f32) -> AreaSample {
+    let mut n = xf.normal(s.n).normalize();
+    if reverse {
+        n = -n;
+    }
+    AreaSample {
+        p: xf.point(s.p),
+        n,
+        pdf: s.pdf / scale2,
+    }
+}

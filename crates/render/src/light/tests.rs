@@ -1,0 +1,161 @@
+//! Light sampling checks: irradiance from closed forms, pdf consistency, and emitted
+//! power of photon sampling equal to the light's power.
+
+use super::*;
+use crate::geometry::sphere::Sphere;
+use radiant_math::Transform;
+use radiant_math::hash::Pcg32;
+
+fn scene() -> SceneSphere {
+    SceneSphere {
+        center: Vec3::ZERO,
+        radius: 10.0,
+    }
+}
+
+fn u2(rng: &mut Pcg32) -> Vec2 {
+    Vec2::new(rng.uniform(), rng.uniform())
+}
+
+/// Irradiance E = mean(Li cos / pdf) at `p` with normal `n`, with its standard error.
+fn irradiance(light: &Light, p: Vec3, n: Vec3, samples: usize) -> (f64, f64) {
+    let mut rng = Pcg32::new(17, 4);
+    let (mut s, mut s2) = (0.0f64, 0.0f64);
+    for _ in 0..samples {
+        let v = light
+            .sample_li(p, u2(&mut rng), scene())
+            .map_or(0.0, |ls| (ls.li.g * ls.wi.dot(n).max(0.0) / ls.pdf) as f64);
+        s += v;
+        s2 += v * v;
+    }
+    let mean = s / samples as f64;
+    let var = (s2 / samples as f64 - mean * mean).max(0.0);
+    (mean, (var / samples as f64).sqrt())
+}
+
+fn square_light(side: f32, height: f32, l: f32) -> Vec<Light> {
+    // Corner at the origin's vertical, facing down (-z); triangles wound for -z normals.
+    let p = [
+        Vec3::new(0.0, 0.0, height),
+        Vec3::new(0.0, side, height),
+        Vec3::new(side, side, height),
+        Vec3::new(side, 0.0, height),
+    ];
+    [[p[0], p[1], p[2]], [p[0], p[2], p[3]]]
+        .into_iter()
+        .map(|t| {
+            Light::Area(AreaLight {
+                shape: LightShape::Triangle {
+                    p: t,
+                    n: -Vec3::Z,
+                    area: 0.5 * side * side,
+                },
+                l: Rgb::splat(l),
+                two_sided: false,
+            })
+        })
+        .collect()
+}
+
+#[test]
+fn rectangle_light_irradiance_matches_the_corner_form_factor() {
+    // Point below the corner of an a x b rectangle at distance c (Howell's catalogue, C-11):
+    // F = 1/(2 pi) [A/sqrt(1+A^2) atan(B/sqrt(1+A^2)) + B/sqrt(1+B^2) atan(A/sqrt(1+B^2))].
+    let (a, c) = (1.0f64, 1.0f64);
+    let (aa, bb) = (a / c, a / c);
+    let f = (aa / (1.0 + aa * aa).sqrt() * (bb / (1.0 + aa * aa).sqrt()).atan()
+        + bb / (1.0 + bb * bb).sqrt() * (aa / (1.0 + bb * bb).sqrt()).atan())
+        / (2.0 * std::f64::consts::PI);
+    let exact = std::f64::consts::PI * f; // E = pi L F with L = 1
+    let (mut e, mut var) = (0.0, 0.0);
+    for light in square_light(1.0, 1.0, 1.0) {
+        let (m, se) = irradiance(&light, Vec3::ZERO, Vec3::Z, 100_000);
+        e += m;
+        var += se * se;
+    }
+    assert!(
+        (e - exact).abs() < 4.0 * var.sqrt() + 1e-6,
+        "{e} vs {exact} (se {})",
+        var.sqrt()
+    );
+}
+
+#[test]
+fn sphere_light_irradiance_is_pi_l_sin2() {
+    let light = Light::Area(AreaLight {
+        shape: LightShape::Sphere {
+            sphere: Sphere::full(1.0).unwrap(),
+            render_from_object: Transform::translate(Vec3::new(0.0, 0.0, 4.0)),
+            reverse: false,
+        },
+        l: Rgb::splat(2.0),
+        two_sided: false,
+    });
+    let exact = std::f64::consts::PI * 2.0 / 16.0;
+    let (e, se) = irradiance(&light, Vec3::ZERO, Vec3::Z, 50_000);
+    assert!((e - exact).abs() < 4.0 * se + 1e-6, "{e} vs {exact} ({se})");
+    // The density reported for a sample equals pdf_li for its point.
+    let mut rng = Pcg32::new(1, 1);
+    for _ in 0..100 {
+        let s = light.sample_li(Vec3::ZERO, u2(&mut rng), scene()).unwrap();
+        let pdf = light.pdf_li(Vec3::ZERO, s.p, s.n, Vec2::ZERO);
+        assert!((pdf - s.pdf).abs() < 1e-3 * s.pdf, "{pdf} vs {}", s.pdf);
+    }
+}
+
+#[test]
+fn triangle_light_pdf_li_matches_its_samples() {
+    let light = &square_light(2.0, 3.0, 1.0)[0];
+    let p = Vec3::new(0.3, -0.2, 0.0);
+    let mut rng = Pcg32::new(2, 2);
+    for _ in 0..100 {
+        let s = light.sample_li(p, u2(&mut rng), scene()).unwrap();
+        let pdf = light.pdf_li(p, s.p, s.n, Vec2::ZERO);
+        assert!((pdf - s.pdf).abs() < 1e-3 * s.pdf);
+    }
+}
+
+/// Photon emission: the mean power of emitted samples is the light's power.
+#[test]
+fn emitted_power_equals_light_power() {
+    let lights = vec![
+        square_light(2.0, 3.0, 1.5).remove(0),
+        Light::Point {
+            position: Vec3::ONE,
+            intensity: Rgb::splat(3.0),
+        },
+        Light::Spot {
+            position: Vec3::ZERO,
+            direction: Vec3::Y,
+            intensity: Rgb::splat(5.0),
+            cos_falloff_start: 30f32.to_radians().cos(),
+            cos_total_width: 40f32.to_radians().cos(),
+        },
+        Light::Distant {
+            direction: -Vec3::Y,
+            radiance: Rgb::splat(2.0),
+        },
+        Light::Infinite {
+            radiance: Rgb::splat(0.5),
+        },
+    ];
+    let mut rng = Pcg32::new(8, 8);
+    for light in &lights {
+        let n = 200_000;
+        let (mut s, mut s2) = (0.0f64, 0.0f64);
+        for _ in 0..n {
+            let v = light
+                .sample_emission(u2(&mut rng), u2(&mut rng), scene())
+                .map_or(0.0, |e| e.power.g as f64);
+            s += v;
+            s2 += v * v;
+        }
+        let mean = s / n as f64;
+        let se = ((s2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
+        let power = light.power(scene()).g as f64;
+        assert!(
+            (mean - power).abs() < 4.0 * se + 1e-6 * power,
+            "{light:?}: {mean} vs {power}"
+        );
+    }
+}

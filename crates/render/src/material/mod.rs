@@ -1,0 +1,173 @@
+//! Materials and their BSDFs, evaluated in the local shading frame (normal = +z).
+//!
+//! The set is closed — Lambertian diffuse, perfect mirror, smooth conductor, smooth
+//! dielectric — so it is one enum with `match`. All are two-sided: a diffuse surface
+//! reflects on both sides, a dielectric knows which side it is entered from.
+
+pub mod fresnel;
+
+use glam::{Vec2, Vec3};
+
+use radiant_math::color::Rgb;
+use radiant_math::{INV_PI, sampling};
+use radiant_scene::{ConductorDesc, MaterialDesc};
+
+/// What a path carries: radiance (camera paths) or importance (light/photon paths).
+/// Refraction scales radiance by 1/eta^2 but not importance (Veach 1997, §5.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransportMode {
+    Radiance,
+    Importance,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Material {
+    /// Lambertian: f = albedo / pi.
+    Diffuse { albedo: Rgb },
+    /// Perfect specular reflector with a fixed reflectance (no Fresnel).
+    Mirror { reflectance: Rgb },
+    /// Smooth conductor with Fresnel reflectance from complex index eta + i k.
+    Conductor { eta: Rgb, k: Rgb },
+    /// Smooth dielectric, index `eta` inside relative to outside (normal side).
+    Dielectric { eta: f32 },
+    /// No surface: paths continue straight through.
+    Interface,
+}
+
+/// A sampled direction with its BSDF value and pdf. For specular lobes `pdf` is the
+/// discrete probability of the lobe and `f` carries a matching 1/|cos| factor, so that
+/// `f |cos| / pdf` is the path weight in every case.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    pub wi: Vec3,
+    pub f: Rgb,
+    pub pdf: f32,
+    pub specular: bool,
+}
+
+impl Material {
+    pub fn from_desc(desc: &MaterialDesc) -> Material {
+        match desc {
+            MaterialDesc::Diffuse { reflectance } => Material::Diffuse {
+                albedo: reflectance.map(|c| c.clamp(0.0, 1.0)),
+            },
+            MaterialDesc::Dielectric { eta } => Material::Dielectric { eta: *eta },
+            MaterialDesc::Conductor(ConductorDesc::Reflectance(r)) => Material::Mirror {
+                reflectance: r.map(|c| c.clamp(0.0, 1.0)),
+            },
+            MaterialDesc::Conductor(ConductorDesc::EtaK { eta, k }) => {
+                Material::Conductor { eta: *eta, k: *k }
+            }
+            MaterialDesc::Interface => Material::Interface,
+        }
+    }
+
+    /// True when the BSDF is a Dirac distribution (no evaluation, only sampling).
+    pub fn is_specular(&self) -> bool {
+        !matches!(self, Material::Diffuse { .. })
+    }
+
+    /// The diffuse reflectance (zero for purely specular materials); radiosity uses
+    /// only this part.
+    pub fn diffuse_albedo(&self) -> Rgb {
+        match self {
+            Material::Diffuse { albedo } => *albedo,
+            _ => Rgb::BLACK,
+        }
+    }
+
+    /// BSDF value for local directions `wo` (towards the viewer) and `wi` (towards the
+    /// light). Specular lobes evaluate to zero.
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        match self {
+            Material::Diffuse { albedo } if wo.z * wi.z > 0.0 => *albedo * INV_PI,
+            _ => Rgb::BLACK,
+        }
+    }
+
+    /// Solid-angle pdf with which `sample` picks `wi` (zero for specular lobes).
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self {
+            Material::Diffuse { .. } if wo.z * wi.z > 0.0 => {
+                sampling::cosine_hemisphere_pdf(wi.z.abs())
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Samples an incident direction for outgoing `wo` from a lobe-choice number `u1`
+    /// and a 2D number `u2`.
+    pub fn sample(&self, wo: Vec3, u1: f32, u2: Vec2, mode: TransportMode) -> Option<BsdfSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        match *self {
+            Material::Diffuse { albedo } => {
+                let mut wi = sampling::cosine_hemisphere(u2);
+                if wo.z < 0.0 {
+                    wi.z = -wi.z;
+                }
+                let pdf = sampling::cosine_hemisphere_pdf(wi.z.abs());
+                (pdf > 0.0).then_some(BsdfSample {
+                    wi,
+                    f: albedo * INV_PI,
+                    pdf,
+                    specular: false,
+                })
+            }
+            Material::Mirror { reflectance } => Some(specular_reflection(wo, reflectance, 1.0)),
+            Material::Conductor { eta, k } => Some(specular_reflection(
+                wo,
+                fresnel::conductor(wo.z, eta, k),
+                1.0,
+            )),
+            Material::Dielectric { eta } => Some(sample_dielectric(wo, eta, u1, mode)),
+            Material::Interface => Some(BsdfSample {
+                wi: -wo,
+                f: Rgb::splat(1.0 / wo.z.abs()),
+                pdf: 1.0,
+                specular: true,
+            }),
+        }
+    }
+}
+
+fn specular_reflection(wo: Vec3, reflectance: Rgb, pdf: f32) -> BsdfSample {
+    let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+    BsdfSample {
+        wi,
+        f: reflectance * (pdf / wi.z.abs()),
+        pdf,
+        specular: true,
+    }
+}
+
+/// Smooth dielectric: reflect with probability R (Fresnel), refract otherwise.
+fn sample_dielectric(wo: Vec3, eta: f32, u: f32, mode: TransportMode) -> BsdfSample {
+    let r = fresnel::dielectric(wo.z, eta);
+    if u < r {
+        return specular_reflection(wo, Rgb::WHITE, r);
+    }
+    let t = 1.0 - r;
+    // Relative index of the side entered over the side left.
+    let (n, eta_rel) = if wo.z > 0.0 {
+        (Vec3::Z, eta)
+    } else {
+        (-Vec3::Z, 1.0 / eta)
+    };
+    let wi = fresnel::refract(wo, n, eta_rel)
+        .expect("total internal reflection has R = 1 and never reaches refraction");
+    let mut f = t / wi.z.abs();
+    if mode == TransportMode::Radiance {
+        f /= eta_rel * eta_rel;
+    }
+    BsdfSample {
+        wi,
+        f: Rgb::splat(f),
+        pdf: t,
+        specular: true,
+    }
+}
+
+#[cfg(test)]
+mod tests;

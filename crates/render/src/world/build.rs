@@ -1,0 +1,392 @@
+//! Building the world from a scene description: geometry to render space in flat
+//! arrays, one light per emitting primitive, the BVH over everything.
+
+use glam::{Mat3, Vec2, Vec3};
+
+use super::shapes::{BilinearPrim, Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr};
+use super::{NO_LIGHT, World};
+use crate::geometry::bilinear::BilinearPatch;
+use crate::geometry::disk::Disk;
+use crate::geometry::sphere::Sphere;
+use crate::light::{AreaLight, Light, LightShape, SceneSphere};
+use crate::material::Material;
+use radiant_math::{Distribution1D, Transform};
+use radiant_scene::{
+    AreaLightDesc, Geometry, LightDesc, SceneDesc, SceneError, ShapeDesc, Warning,
+};
+
+/// Errors building the world are scene errors: they name the shape's location.
+pub type BuildError = SceneError;
+
+impl World {
+    /// Builds the render-ready world. Returns warnings for things that work only
+    /// approximately (they are never silent).
+    pub fn build(desc: &SceneDesc) -> Result<(World, Vec<Warning>), BuildError> {
+        let mut warnings = Vec::new();
+        let materials: Vec<Material> = desc.materials.iter().map(Material::from_desc).collect();
+        let mut lights = Vec::new();
+
+        let mut prototypes = Vec::with_capacity(desc.objects.len());
+        for object in &desc.objects {
+            let mut set = ShapeSet::default();
+            for shape in &object.shapes {
+                // pbrt does not support area lights in instances either; the parser warned.
+                add_shape(&mut set, shape, &materials, None, &mut warnings)?;
+            }
+            set.finish(&[]);
+            prototypes.push(set);
+        }
+
+        let mut top = ShapeSet::default();
+        for shape in &desc.shapes {
+            add_shape(
+                &mut top,
+                shape,
+                &materials,
+                Some(&mut lights),
+                &mut warnings,
+            )?;
+        }
+        for inst in &desc.instances {
+            if prototypes[inst.object].is_empty() {
+                continue;
+            }
+            let i = top.instances.len() as u32;
+            top.instances.push(Instance {
+                prototype: inst.object as u32,
+                render_from_instance: inst.render_from_instance,
+            });
+            top.prims.push(PrimRef::Instance(i));
+        }
+        top.finish(&prototypes);
+        let bounds = top.bounds();
+
+        let mut world = World {
+            geometry: top,
+            prototypes,
+            materials,
+            lights,
+            light_distribution: Distribution1D::default(),
+            bounds,
+        };
+        let scene = world.scene_sphere();
+        for l in &desc.lights {
+            world.lights.push(light_from_desc(l));
+        }
+        let powers: Vec<f32> = world
+            .lights
+            .iter()
+            .map(|l| l.power(scene).average())
+            .collect();
+        world.light_distribution = Distribution1D::new(&powers);
+        Ok((world, warnings))
+    }
+
+    /// The scene's bounding sphere, for lights at infinity.
+    pub fn scene_sphere(&self) -> SceneSphere {
+        let (center, radius) = self.bounds.bounding_sphere();
+        SceneSphere {
+            center,
+            radius: radius.max(1e-3),
+        }
+    }
+}
+
+fn light_from_desc(l: &LightDesc) -> Light {
+    match l {
+        LightDesc::Point {
+            position,
+            intensity,
+            ..
+        } => Light::Point {
+            position: *position,
+            intensity: *intensity,
+        },
+        LightDesc::Spot {
+            position,
+            direction,
+            intensity,
+            cos_falloff_start,
+            cos_total_width,
+            ..
+        } => Light::Spot {
+            position: *position,
+            direction: direction.normalize(),
+            intensity: *intensity,
+            cos_falloff_start: *cos_falloff_start,
+            cos_total_width: *cos_total_width,
+        },
+        LightDesc::Distant {
+            direction,
+            radiance,
+            ..
+        } => Light::Distant {
+            direction: direction.normalize(),
+            radiance: *radiance,
+        },
+        LightDesc::Infinite { radiance, .. } => Light::Infinite {
+            radiance: *radiance,
+        },
+    }
+}
+
+fn is_similarity(xf: &Transform) -> bool {
+    let m = Mat3::from_mat4(xf.m);
+    let (a, b, c) = (m.x_axis.length(), m.y_axis.length(), m.z_axis.length());
+    let tol = 1e-4 * a.max(b).max(c);
+    (a - b).abs() < tol
+        && (a - c).abs() < tol
+        && m.x_axis.dot(m.y_axis).abs() < tol * a
+        && m.x_axis.dot(m.z_axis).abs() < tol * a
+        && m.y_axis.dot(m.z_axis).abs() < tol * a
+}
+
+/// Adds one shape's primitives; area lights go to `lights` (None inside prototypes).
+fn add_shape(
+    set: &mut ShapeSet,
+    shape: &ShapeDesc,
+    materials: &[Material],
+    lights: Option<&mut Vec<Light>>,
+    warnings: &mut Vec<Warning>,
+) -> Result<(), BuildError> {
+    let material = shape.material;
+    if materials.get(material as usize).is_none() {
+        return Err(SceneError::at(
+            &shape.loc,
+            format!("material index {material} out of range"),
+        ));
+    }
+    let emission = match lights {
+        Some(lights) => shape.area_light.clone().map(|a| (a, lights)),
+        None => None,
+    };
+    // An interface without emission is no surface at all.
+    if materials[material as usize] == Material::Interface && emission.is_none() {
+        return Ok(());
+    }
+    let xf = shape.render_from_object;
+    let ro = shape.reverse_orientation;
+    match &shape.geometry {
+        Geometry::TriangleMesh {
+            positions,
+            indices,
+            normals,
+            uvs,
+        } => add_mesh(
+            set,
+            shape,
+            positions,
+            indices.clone(),
+            normals,
+            uvs,
+            emission,
+        ),
+        Geometry::BilinearMesh {
+            positions,
+            indices,
+            normals,
+            uvs,
+        } => {
+            // Planar patches (p00, p10, p01, p11) become the triangles (p00,p10,p11),
+            // (p00,p11,p01) — exactly what the patch intersector does for them — so they
+            // share the triangle BVH; curved ones stay patches (Reshetov 2019).
+            let orientation = if ro ^ xf.swaps_handedness() {
+                -1.0
+            } else {
+                1.0
+            };
+            let mut tris = Vec::with_capacity(indices.len() / 4 * 6);
+            let mut emission = emission;
+            for q in indices.chunks_exact(4) {
+                let [a, b, c, d] = [q[0], q[1], q[2], q[3]];
+                let [p00, p10, p01, p11] = [a, b, c, d].map(|i| xf.point(positions[i as usize]));
+                let patch = BilinearPatch::new(p00, p10, p01, p11);
+                if patch.is_planar() {
+                    tris.extend_from_slice(&[a, b, d, a, d, c]);
+                    continue;
+                }
+                let light = match &mut emission {
+                    Some((desc, lights)) => {
+                        push_light(lights, desc, LightShape::Bilinear { patch, orientation })
+                    }
+                    None => NO_LIGHT,
+                };
+                let i = set.bilinears.len() as u32;
+                set.bilinears.push(BilinearPrim {
+                    patch,
+                    material,
+                    light,
+                    orientation,
+                });
+                set.prims.push(PrimRef::Bilinear(i));
+            }
+            if normals.is_some() && !set.bilinears.is_empty() {
+                warnings.push(Warning {
+                    loc: shape.loc.clone(),
+                    message: "shading normals on curved bilinear patches are not interpolated; geometric normals are used"
+                        .into(),
+                });
+            }
+            add_mesh(set, shape, positions, tris, normals, uvs, emission)
+        }
+        Geometry::Sphere {
+            radius,
+            z_min,
+            z_max,
+            phi_max_deg,
+        } => {
+            let sphere = Sphere::partial(*radius, *z_min, *z_max, *phi_max_deg)
+                .map_err(|e| SceneError::at(&shape.loc, format!("sphere: {e}")))?;
+            let light = emission.map_or(NO_LIGHT, |(a, lights)| {
+                if !is_similarity(&xf) {
+                    warnings.push(non_similar_warning(shape));
+                }
+                push_light(
+                    lights,
+                    &a,
+                    LightShape::Sphere {
+                        sphere,
+                        render_from_object: xf,
+                        reverse: ro,
+                    },
+                )
+            });
+            let i = set.spheres.len() as u32;
+            set.spheres.push(Placed {
+                shape: sphere,
+                render_from_object: xf,
+                material,
+                light,
+                reverse: ro,
+            });
+            set.prims.push(PrimRef::Sphere(i));
+        }
+        Geometry::Disk {
+            height,
+            radius,
+            inner_radius,
+            phi_max_deg,
+        } => {
+            let disk = Disk::new(*height, *radius, *inner_radius, *phi_max_deg)
+                .map_err(|e| SceneError::at(&shape.loc, format!("disk: {e}")))?;
+            let light = emission.map_or(NO_LIGHT, |(a, lights)| {
+                if !is_similarity(&xf) {
+                    warnings.push(non_similar_warning(shape));
+                }
+                let scale2 = Mat3::from_mat4(xf.m).determinant().abs().powf(2.0 / 3.0);
+                push_light(
+                    lights,
+                    &a,
+                    LightShape::Disk {
+                        disk,
+                        render_from_object: xf,
+                        reverse: ro,
+                        scale2,
+                    },
+                )
+            });
+            let i = set.disks.len() as u32;
+            set.disks.push(Placed {
+                shape: disk,
+                render_from_object: xf,
+                material,
+                light,
+                reverse: ro,
+            });
+            set.prims.push(PrimRef::Disk(i));
+        }
+    }
+    Ok(())
+}
+
+fn non_similar_warning(shape: &ShapeDesc) -> Warning {
+    Warning {
+        loc: shape.loc.clone(),
+        message: "area light on a non-uniformly scaled quadric: light sampling assumes a uniform scale and will be biased"
+            .into(),
+    }
+}
+
+fn push_light(lights: &mut Vec<Light>, a: &AreaLightDesc, shape: LightShape) -> u32 {
+    lights.push(Light::Area(AreaLight {
+        shape,
+        l: a.l,
+        two_sided: a.two_sided,
+    }));
+    (lights.len() - 1) as u32
+}
+
+fn add_mesh(
+    set: &mut ShapeSet,
+    shape: &ShapeDesc,
+    positions: &[Vec3],
+    indices: Vec<u32>,
+    normals: &Option<Vec<Vec3>>,
+    uvs: &Option<Vec<Vec2>>,
+    mut emission: Option<(AreaLightDesc, &mut Vec<Light>)>,
+) {
+    let xf = shape.render_from_object;
+    let ro = shape.reverse_orientation;
+    let orientation = if ro ^ xf.swaps_handedness() {
+        -1.0
+    } else {
+        1.0
+    };
+    let p: Vec<Vec3> = positions.iter().map(|&v| xf.point(v)).collect();
+    // pbrt-v4 flips per-vertex normals under ReverseOrientation.
+    let n: Option<Vec<Vec3>> = normals.as_ref().map(|ns| {
+        ns.iter()
+            .map(|&v| {
+                let w = xf.normal(v).normalize_or_zero();
+                if ro { -w } else { w }
+            })
+            .collect()
+    });
+    let mesh = set.meshes.len() as u32;
+    for (k, tri) in indices.chunks_exact(3).enumerate() {
+        let v = [tri[0], tri[1], tri[2]].map(|i| i as usize);
+        let pts = v.map(|i| p[i]);
+        let light = match &mut emission {
+            None => NO_LIGHT,
+            Some((a, lights)) => {
+                let cross = (pts[1] - pts[0]).cross(pts[2] - pts[0]);
+                let area = 0.5 * cross.length();
+                if area > 0.0 {
+                    // With shading normals the front follows them (pbrt-v4), else the winding.
+                    let mut front = cross.normalize();
+                    match &n {
+                        Some(ns) if (ns[v[0]] + ns[v[1]] + ns[v[2]]).dot(front) < 0.0 => {
+                            front = -front
+                        }
+                        Some(_) => {}
+                        None => front *= orientation,
+                    }
+                    push_light(
+                        lights,
+                        a,
+                        LightShape::Triangle {
+                            p: pts,
+                            n: front,
+                            area,
+                        },
+                    )
+                } else {
+                    NO_LIGHT
+                }
+            }
+        };
+        set.triangles.push(pts);
+        set.triangle_attrs.push(TriangleAttr {
+            mesh,
+            index: k as u32,
+            material: shape.material,
+            light,
+            orientation,
+        });
+    }
+    set.meshes.push(MeshAttrs {
+        indices,
+        normals: n,
+        uvs: uvs.clone(),
+    });
+}

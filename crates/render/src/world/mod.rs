@@ -1,0 +1,107 @@
+//! The render-ready world: geometry flattened into render-space arrays behind one BVH,
+//! materials and lights, built once from a [`SceneDesc`](radiant_scene::SceneDesc).
+//!
+//! Queries are the two an accelerator provides — closest hit and any hit — and the
+//! lazy expansion of a hit into a [`SurfaceHit`] with positions, normals and uvs.
+
+mod build;
+mod shapes;
+
+use glam::{Vec2, Vec3};
+
+pub use build::BuildError;
+pub use shapes::ShapeSet;
+
+use crate::geometry::ray::offset_origin;
+use crate::geometry::{Aabb, Ray};
+use crate::light::Light;
+use crate::material::Material;
+use radiant_math::Distribution1D;
+
+/// No light attached (in per-primitive light indices).
+pub const NO_LIGHT: u32 = u32::MAX;
+
+/// A ray hit expanded into what shading needs.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    pub p: Vec3,
+    /// Unit geometric normal, oriented as the shape's (emitting) front side.
+    pub ng: Vec3,
+    /// Unit shading normal, on the same side as `ng`.
+    pub ns: Vec3,
+    pub uv: Vec2,
+    pub material: u32,
+    /// Index of the area light of this primitive, or [`NO_LIGHT`].
+    pub light: u32,
+}
+
+impl SurfaceHit {
+    /// Origin for a ray leaving the surface towards `w`, offset off the surface.
+    pub fn spawn_origin(&self, w: Vec3) -> Vec3 {
+        offset_origin(self.p, self.ng, w)
+    }
+
+    pub fn spawn_ray(&self, w: Vec3) -> Ray {
+        Ray::new(self.spawn_origin(w), w)
+    }
+}
+
+/// Everything an integrator traces against.
+pub struct World {
+    pub(crate) geometry: ShapeSet,
+    /// Object prototypes for instancing (in instance space).
+    pub(crate) prototypes: Vec<ShapeSet>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    /// Picks a light in proportion to its emitted power.
+    pub light_distribution: Distribution1D,
+    pub bounds: Aabb,
+}
+
+impl World {
+    /// Closest hit in `(0, t_max)`.
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
+        self.geometry.intersect(ray, t_max, &self.prototypes)
+    }
+
+    /// True when anything blocks the ray in `(0, t_max)`.
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        self.geometry.occluded(ray, t_max, &self.prototypes)
+    }
+
+    /// True when the segment from a surface point (offset along its normal `n0`) to `p1`
+    /// is free; `n1` is the normal at `p1` (zero for points in free space).
+    pub fn visible(&self, p0: Vec3, n0: Vec3, p1: Vec3, n1: Vec3) -> bool {
+        let o = offset_origin(p0, n0, p1 - p0);
+        let target = if n1 == Vec3::ZERO {
+            p1
+        } else {
+            offset_origin(p1, n1, o - p1)
+        };
+        let d = target - o;
+        !self.occluded(&Ray::new(o, d), 1.0 - 1e-4)
+    }
+
+    /// Bounding spheres (centre, radius) of the specular geometry (mirrors, conductors,
+    /// glass): one per mesh, quadric or instance that has any.
+    pub fn specular_bounds(&self) -> Vec<(Vec3, f32)> {
+        let pick = |m: u32| {
+            let m = &self.materials[m as usize];
+            m.is_specular() && *m != Material::Interface
+        };
+        self.geometry
+            .bounding_spheres_where(&self.prototypes, &pick)
+    }
+
+    /// Centre and radius of a sphere enclosing the scene (for distant and infinite lights).
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        self.bounds.bounding_sphere()
+    }
+
+    /// Number of primitives (triangles, spheres, ... and instances) at the top level.
+    pub fn primitive_count(&self) -> usize {
+        self.geometry.len()
+    }
+}

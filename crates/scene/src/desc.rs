@@ -1,0 +1,358 @@
+//! The scene description: plain data produced by the pbrt parser or by the canonical
+//! scenes in code, and consumed by `render` and `radiosity`.
+//!
+//! Geometry is kept in object space with its `render_from_object` transform (render
+//! space = pbrt's world space). Radiometric values are final: light `scale` and `power`
+//! have already been folded into `L` / `I`.
+
+use std::path::PathBuf;
+
+use glam::{Vec2, Vec3};
+
+use super::error::{FileLoc, Warning};
+use super::params::ParamSet;
+use radiant_math::Transform;
+use radiant_math::color::Rgb;
+
+/// Everything needed to render one image.
+#[derive(Clone, Debug)]
+pub struct SceneDesc {
+    pub camera: CameraDesc,
+    pub film: FilmDesc,
+    pub sampler: SamplerDesc,
+    pub filter: FilterDesc,
+    pub integrator: IntegratorDesc,
+    pub materials: Vec<MaterialDesc>,
+    pub shapes: Vec<ShapeDesc>,
+    /// Object prototypes (`ObjectBegin`); their shapes are in instance space.
+    pub objects: Vec<ObjectDesc>,
+    pub instances: Vec<InstanceDesc>,
+    pub lights: Vec<LightDesc>,
+    /// Everything read but not supported, and parameters never used.
+    pub warnings: Vec<Warning>,
+    /// The scene file, when the scene came from one (relative paths resolve from its folder).
+    pub source: Option<PathBuf>,
+}
+
+/// `Camera`: where it is and how it forms the image.
+#[derive(Clone, Debug)]
+pub struct CameraDesc {
+    /// The current transform at the `Camera` directive.
+    pub camera_from_world: Transform,
+    pub kind: CameraKind,
+    pub loc: FileLoc,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum CameraKind {
+    /// `"perspective"`: `fov` (degrees, spans the shorter image axis), thin-lens depth of
+    /// field from `lensradius` and `focaldistance`; `screenwindow` overrides the window.
+    Perspective {
+        fov_deg: f32,
+        lens_radius: f32,
+        focal_distance: f32,
+        screen_window: Option<[f32; 4]>,
+    },
+    /// `"orthographic"`: parallel projection through `screenwindow` (default [-1,1] on the
+    /// shorter axis).
+    Orthographic {
+        lens_radius: f32,
+        focal_distance: f32,
+        screen_window: Option<[f32; 4]>,
+    },
+    /// `"realistic"`: rays through a lens prescription (Kolb, Mitchell & Hanrahan 1995).
+    /// `lens_file` is already resolved against the scene file's folder.
+    Realistic {
+        lens_file: PathBuf,
+        aperture_diameter_mm: f32,
+        focus_distance: f32,
+    },
+}
+
+/// `Film "rgb"`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilmDesc {
+    pub xresolution: u32,
+    pub yresolution: u32,
+    /// Output name from the file; the CLI's `-o` overrides it.
+    pub filename: Option<String>,
+    /// Film diagonal in mm (used by the realistic camera); pbrt default 35.
+    pub diagonal_mm: f32,
+    /// Sensor sensitivity; pbrt-v4 scales the image by `iso / 100` for the realistic
+    /// camera's physical exposure. Default 100.
+    pub iso: f32,
+    pub loc: FileLoc,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplerKind {
+    /// Owen-scrambled Sobol (any low-discrepancy pbrt sampler maps here).
+    Sobol,
+    /// Independent uniform random numbers.
+    Independent,
+}
+
+/// `Sampler`: kind, samples per pixel and seed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SamplerDesc {
+    pub kind: SamplerKind,
+    pub pixel_samples: u32,
+    pub seed: u64,
+    pub loc: FileLoc,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FilterKind {
+    Box,
+    Triangle,
+    /// pbrt-v4's truncated Gaussian with standard deviation `sigma` (pixels).
+    Gaussian {
+        sigma: f32,
+    },
+}
+
+/// `PixelFilter`: kind and radius in pixels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilterDesc {
+    pub kind: FilterKind,
+    pub radius: Vec2,
+    pub loc: FileLoc,
+}
+
+/// `Integrator`: the name and its parameters, which the chosen integrator reads (and
+/// whose unused entries it reports) when the render is set up.
+#[derive(Clone, Debug)]
+pub struct IntegratorDesc {
+    pub name: String,
+    pub params: ParamSet,
+    pub loc: FileLoc,
+}
+
+/// Index into `SceneDesc::materials`.
+pub type MaterialId = u32;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum MaterialDesc {
+    /// Lambertian reflector, `reflectance` in [0,1] per channel.
+    Diffuse { reflectance: Rgb },
+    /// Smooth dielectric interface with relative index `eta` (inside / outside).
+    Dielectric { eta: f32 },
+    /// Smooth conductor: a perfect mirror with the given reflectance, or Fresnel
+    /// reflection from complex index `eta + i k` per channel.
+    Conductor(ConductorDesc),
+    /// `"interface"`: no surface at all (a boundary between media); rays pass through.
+    Interface,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ConductorDesc {
+    Reflectance(Rgb),
+    EtaK { eta: Rgb, k: Rgb },
+}
+
+/// A diffuse area light attached to a shape (`AreaLightSource "diffuse"`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AreaLightDesc {
+    /// Emitted radiance, `scale` (and `power`) already applied.
+    pub l: Rgb,
+    /// Emits on both sides; otherwise only on the side of the surface normal.
+    pub two_sided: bool,
+}
+
+/// Shape geometry in object space.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Geometry {
+    /// Triangles: three indices each into `positions`. Optional per-vertex shading
+    /// normals and uvs (same length as `positions`).
+    ///
+    /// Which side faces out (pbrt-v4): without `normals`, the geometric normal is
+    /// (p1 - p0) × (p2 - p0) in render space, flipped when `reverse_orientation` is set
+    /// or when `render_from_object` swaps handedness (both: no flip). With `normals`,
+    /// the shading normal (interpolated N, transformed as a normal, negated when
+    /// `reverse_orientation` is set) is authoritative: the geometric normal is turned
+    /// to its side. A one-sided area light emits on the side of the geometric normal.
+    TriangleMesh {
+        positions: Vec<Vec3>,
+        indices: Vec<u32>,
+        normals: Option<Vec<Vec3>>,
+        uvs: Option<Vec<Vec2>>,
+    },
+    /// Bilinear patches: four indices each, in pbrt's order (p00, p10, p01, p11).
+    BilinearMesh {
+        positions: Vec<Vec3>,
+        indices: Vec<u32>,
+        normals: Option<Vec<Vec3>>,
+        uvs: Option<Vec<Vec2>>,
+    },
+    /// Sphere about the object-space origin (pbrt: `radius`, `zmin`, `zmax`, `phimax` degrees).
+    Sphere {
+        radius: f32,
+        z_min: f32,
+        z_max: f32,
+        phi_max_deg: f32,
+    },
+    /// Disk in the plane z = `height`, normal +z.
+    Disk {
+        height: f32,
+        radius: f32,
+        inner_radius: f32,
+        phi_max_deg: f32,
+    },
+}
+
+/// One `Shape` with the graphics state that applied to it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShapeDesc {
+    pub geometry: Geometry,
+    pub render_from_object: Transform,
+    /// `ReverseOrientation` was in effect (flips the normal, and so the emitting side;
+    /// for meshes with shading normals it flips those, see [`Geometry::TriangleMesh`]).
+    pub reverse_orientation: bool,
+    pub material: MaterialId,
+    pub area_light: Option<AreaLightDesc>,
+    pub loc: FileLoc,
+}
+
+impl ShapeDesc {
+    /// Planar quads `(v0, v1, v2, v3)` as one triangle mesh of the triangles
+    /// `(v0, v1, v2)`, `(v0, v2, v3)` each, in render space, not emitting.
+    pub fn quads(list: &[[Vec3; 4]], material: MaterialId, loc: FileLoc) -> ShapeDesc {
+        let mut positions = Vec::with_capacity(4 * list.len());
+        let mut indices = Vec::with_capacity(6 * list.len());
+        for q in list {
+            let base = positions.len() as u32;
+            positions.extend_from_slice(q);
+            indices.extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+        }
+        ShapeDesc {
+            geometry: Geometry::TriangleMesh {
+                positions,
+                indices,
+                normals: None,
+                uvs: None,
+            },
+            render_from_object: Transform::IDENTITY,
+            reverse_orientation: false,
+            material,
+            area_light: None,
+            loc,
+        }
+    }
+}
+
+/// `ObjectBegin "name"` … `ObjectEnd`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectDesc {
+    pub name: String,
+    pub shapes: Vec<ShapeDesc>,
+    pub loc: FileLoc,
+}
+
+/// `ObjectInstance "name"` with the transform in effect.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InstanceDesc {
+    /// Index into `SceneDesc::objects`.
+    pub object: usize,
+    pub render_from_instance: Transform,
+    pub loc: FileLoc,
+}
+
+/// `LightSource`. Positions and directions are in render space; `scale` and `power`
+/// are already applied.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LightDesc {
+    /// Isotropic point light with radiant intensity `intensity` (W/sr per channel).
+    Point {
+        position: Vec3,
+        intensity: Rgb,
+        loc: FileLoc,
+    },
+    /// Spot light at `position` aimed along unit `direction`; full intensity inside
+    /// `cos_falloff_start`, smoothly falling to zero at `cos_total_width` (pbrt-v4).
+    Spot {
+        position: Vec3,
+        direction: Vec3,
+        intensity: Rgb,
+        cos_falloff_start: f32,
+        cos_total_width: f32,
+        loc: FileLoc,
+    },
+    /// Directional light: radiance arrives travelling along unit `direction`
+    /// (from `from` towards `to`), irradiance `radiance` on a perpendicular surface.
+    Distant {
+        direction: Vec3,
+        radiance: Rgb,
+        loc: FileLoc,
+    },
+    /// Constant environment radiance from every direction.
+    Infinite { radiance: Rgb, loc: FileLoc },
+}
+
+/// The z range `(low, high)` of a sphere of `radius` cut at `z_min` and `z_max`, as
+/// pbrt-v4 reads them: clamped to the sphere, either order.
+pub fn sphere_z_range(radius: f32, z_min: f32, z_max: f32) -> (f32, f32) {
+    let r = radius.abs();
+    let (a, b) = (z_min.clamp(-r, r), z_max.clamp(-r, r));
+    (a.min(b), a.max(b))
+}
+
+impl Geometry {
+    /// Surface area in render space. Meshes are measured after the transform; spheres
+    /// and disks by their object-space formula times the transform's mean area scale
+    /// |det|^(2/3) (exact for uniform scales). Used for light `power` and default patch sizes.
+    pub fn surface_area(&self, render_from_object: &glam::Mat4) -> f32 {
+        let area_scale = glam::Mat3::from_mat4(*render_from_object)
+            .determinant()
+            .abs()
+            .powf(2.0 / 3.0);
+        let point = |p: Vec3| render_from_object.transform_point3(p);
+        let phi = |deg: f32| deg.to_radians().clamp(0.0, std::f32::consts::TAU);
+        match self {
+            Geometry::TriangleMesh {
+                positions, indices, ..
+            } => indices
+                .chunks_exact(3)
+                .map(|tri| {
+                    let [a, b, c] = [0, 1, 2].map(|k| point(positions[tri[k] as usize]));
+                    0.5 * (b - a).cross(c - a).length()
+                })
+                .sum(),
+            Geometry::BilinearMesh {
+                positions, indices, ..
+            } => indices
+                .chunks_exact(4)
+                .map(|q| {
+                    super::mesh::bilinear_patch_area(
+                        [0, 1, 2, 3].map(|k| point(positions[q[k] as usize])),
+                    )
+                })
+                .sum(),
+            Geometry::Sphere {
+                radius,
+                z_min,
+                z_max,
+                phi_max_deg,
+            } => {
+                let (low, high) = sphere_z_range(*radius, *z_min, *z_max);
+                phi(*phi_max_deg) * radius.abs() * (high - low) * area_scale
+            }
+            Geometry::Disk {
+                radius,
+                inner_radius,
+                phi_max_deg,
+                ..
+            } => {
+                0.5 * phi(*phi_max_deg)
+                    * (radius * radius - inner_radius * inner_radius).max(0.0)
+                    * area_scale
+            }
+        }
+    }
+}
+
+impl SceneDesc {
+    /// The file name to write: the film's, or a default.
+    pub fn output_name(&self) -> &str {
+        self.film.filename.as_deref().unwrap_or("radiant.exr")
+    }
+}

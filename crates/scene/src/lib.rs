@@ -1,0 +1,22 @@
+//! Scene input: the pbrt-v4 tokenizer and parser, mesh readers (PLY, OBJ), and the
+//! canonical scenes built in code. Everything ends in a [`SceneDesc`]: plain data that
+//! the renderer and the radiosity solver read.
+
+#![forbid(unsafe_code)]
+
+pub mod builtin;
+pub mod desc;
+pub mod error;
+pub mod mesh;
+pub mod named_spectra;
+pub mod obj;
+pub mod params;
+pub mod parser;
+pub mod ply;
+pub mod spectrum;
+pub mod token;
+
+pub use desc::*;
+pub use error::{FileLoc, SceneError, Warning};
+pub use params::{Param, ParamSet, ParamValue};
+pub use parser::{parse_file, parse_str};

@@ -1,0 +1,216 @@
+//! `LightSource` and `AreaLightSource`.
+//!
+//! Radiometry follows pbrt-v4: an `rgb` emission renders as that RGB × `scale`;
+//! `blackbody` and sampled spectra are normalised to luminance 1 first. `power`
+//! (point, spot, area) and `illuminance` (distant, infinite) rescale the emission so
+//! that its luminance-weighted power (or illuminance) equals the number given —
+//! pbrt-v4 normalises only the spectrum's illuminant there and ignores the RGB
+//! multiplier, so the two agree exactly for white and differ by the RGB's luminance
+//! otherwise.
+//!
+//! - `"point"`: `I` (white), `from` (0,0,0), `scale`, `power`.
+//! - `"spot"`: `I`, `from` (0,0,0), `to` (0,0,1), `coneangle` 30°, `conedeltaangle` 5°,
+//!   `scale`, `power`.
+//! - `"distant"`: `L`, `from` (0,0,0), `to` (0,0,1), `scale`, `illuminance`.
+//! - `"infinite"`: `L` (constant only), `scale`, `illuminance`.
+//! - `AreaLightSource "diffuse"`: `L`, `scale`, `twosided` (false), `power`.
+
+use glam::Vec3;
+
+use super::Parser;
+use super::spectrum_param::SpectrumUse;
+use super::state::{AreaLightState, with_defaults};
+use crate::desc::LightDesc;
+use crate::error::{FileLoc, SceneError};
+use crate::params::{ParamSet, ParamValue};
+use radiant_math::PI;
+use radiant_math::color::Rgb;
+
+/// Factor that gives `emission` the luminance `target` (1 when either is not positive).
+fn photometric_factor(emission: Rgb, target: f32) -> f32 {
+    let y = emission.luminance();
+    if target > 0.0 && y > 0.0 {
+        target / y
+    } else {
+        1.0
+    }
+}
+
+impl Parser {
+    /// pbrt-v4's `float scale`; pbrt-v3's spectral `scale` is accepted too.
+    fn light_scale(&mut self, ps: &ParamSet, owner: &str) -> Result<Rgb, SceneError> {
+        let Some(p) = ps.lookup("scale") else {
+            return Ok(Rgb::WHITE);
+        };
+        let s = match &p.value {
+            ParamValue::Float(v) if v.len() == 1 => Rgb::splat(v[0]),
+            ParamValue::Rgb(v) if v.len() == 1 => {
+                let at = p.loc.clone();
+                self.warn(
+                    &at,
+                    format!("{owner}: a spectral \"scale\" is pbrt-v3 syntax; applied per channel"),
+                );
+                v[0]
+            }
+            other => {
+                return Err(SceneError::at(
+                    &p.loc,
+                    format!(
+                        "parameter \"scale\" has type \"{}\" or the wrong count; expected one float",
+                        other.type_name()
+                    ),
+                ));
+            }
+        };
+        if !s.is_finite() {
+            return Err(SceneError::at(&p.loc, "light \"scale\" must be finite"));
+        }
+        Ok(s)
+    }
+
+    /// An optional positive number (`power`, `illuminance`); pbrt's default is -1, off.
+    fn optional_positive(ps: &ParamSet, name: &str) -> Result<Option<f32>, SceneError> {
+        let v = ps.finite_float(name, -1.0)?;
+        Ok((v > 0.0).then_some(v))
+    }
+
+    pub(super) fn light_source(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (name, _) = self.string_arg("LightSource")?;
+        let ps = with_defaults(self.param_list()?, &self.gs.defaults.light);
+        self.require_world("LightSource", loc)?;
+        let owner = format!("LightSource \"{name}\"");
+        if self.object.is_some() {
+            ps.mark_all_used();
+            self.warn(
+                loc,
+                format!("{owner} inside an object definition is ignored"),
+            );
+            return Ok(());
+        }
+        let ctm = self.gs.ctm;
+        let light = match name.as_str() {
+            "point" | "spot" => {
+                let scale = self.light_scale(&ps, &owner)?;
+                let i = self.spectrum_or(&ps, "I", SpectrumUse::Illuminant, Rgb::WHITE, &owner)?
+                    * scale;
+                let power = Self::optional_positive(&ps, "power")?;
+                let from = ps.point3("from", Vec3::ZERO)?;
+                let position = ctm.point(from);
+                if name == "point" {
+                    LightDesc::Point {
+                        position,
+                        // Φ = 4π I for an isotropic point light.
+                        intensity: power
+                            .map_or(i, |phi| i * photometric_factor(i, phi / (4.0 * PI))),
+                        loc: loc.clone(),
+                    }
+                } else {
+                    let to = ps.point3("to", Vec3::Z)?;
+                    let direction = ctm.vector(to - from).normalize_or_zero();
+                    if direction == Vec3::ZERO || !direction.is_finite() {
+                        return Err(SceneError::at(
+                            loc,
+                            format!("{owner}: \"from\" and \"to\" coincide"),
+                        ));
+                    }
+                    let cone = ps.finite_float("coneangle", 30.0)?;
+                    let delta = ps.finite_float("conedeltaangle", 5.0)?;
+                    let cos_total_width = cone.to_radians().cos();
+                    let cos_falloff_start = (cone - delta).to_radians().cos();
+                    // Φ = 2π I [(1 - cos_start) + (cos_start - cos_end) / 2]: full
+                    // intensity inside the inner cone, and the smoothstep falloff
+                    // integrates to half its width in cos θ (it is symmetric about its
+                    // midpoint).
+                    let solid_angle = 2.0
+                        * PI
+                        * ((1.0 - cos_falloff_start) + 0.5 * (cos_falloff_start - cos_total_width));
+                    LightDesc::Spot {
+                        position,
+                        direction,
+                        intensity: power
+                            .map_or(i, |phi| i * photometric_factor(i, phi / solid_angle)),
+                        cos_falloff_start,
+                        cos_total_width,
+                        loc: loc.clone(),
+                    }
+                }
+            }
+            "distant" | "infinite" => {
+                let scale = self.light_scale(&ps, &owner)?;
+                let l = self.spectrum_or(&ps, "L", SpectrumUse::Illuminant, Rgb::WHITE, &owner)?
+                    * scale;
+                let e = Self::optional_positive(&ps, "illuminance")?;
+                if name == "distant" {
+                    let from = ps.point3("from", Vec3::ZERO)?;
+                    let to = ps.point3("to", Vec3::Z)?;
+                    let direction = ctm.vector(to - from).normalize_or_zero();
+                    if direction == Vec3::ZERO || !direction.is_finite() {
+                        return Err(SceneError::at(
+                            loc,
+                            format!("{owner}: \"from\" and \"to\" coincide"),
+                        ));
+                    }
+                    LightDesc::Distant {
+                        direction,
+                        // A distant light's "radiance" is the irradiance it delivers
+                        // on a surface facing it.
+                        radiance: e.map_or(l, |e| l * photometric_factor(l, e)),
+                        loc: loc.clone(),
+                    }
+                } else {
+                    for unsupported in ["filename", "portal"] {
+                        if let Some(p) = ps.lookup(unsupported) {
+                            let at = p.loc.clone();
+                            self.warn(&at, format!("{owner}: \"{unsupported}\" is not supported; using constant radiance L"));
+                        }
+                    }
+                    LightDesc::Infinite {
+                        // Constant L over the upper hemisphere gives E = π L on an
+                        // upward-facing surface.
+                        radiance: e.map_or(l, |e| l * photometric_factor(l, e / PI)),
+                        loc: loc.clone(),
+                    }
+                }
+            }
+            "goniometric" | "projection" => {
+                ps.mark_all_used();
+                self.warn(loc, format!("{owner} is not supported; light skipped"));
+                return Ok(());
+            }
+            _ => return Err(SceneError::at(loc, format!("unknown light \"{name}\""))),
+        };
+        self.report_unused(&ps, &owner);
+        self.lights.push(light);
+        Ok(())
+    }
+
+    pub(super) fn area_light_source(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (name, _) = self.string_arg("AreaLightSource")?;
+        let ps = with_defaults(self.param_list()?, &self.gs.defaults.light);
+        self.require_world("AreaLightSource", loc)?;
+        let owner = format!("AreaLightSource \"{name}\"");
+        if name != "diffuse" {
+            return Err(SceneError::at(
+                loc,
+                format!("unknown area light \"{name}\""),
+            ));
+        }
+        let scale = self.light_scale(&ps, &owner)?;
+        let l = self.spectrum_or(&ps, "L", SpectrumUse::Illuminant, Rgb::WHITE, &owner)? * scale;
+        if let Some(p) = ps.lookup("filename") {
+            let at = p.loc.clone();
+            self.warn(
+                &at,
+                format!("{owner}: image emission is not supported; using constant L"),
+            );
+        }
+        let state = AreaLightState {
+            l,
+            two_sided: ps.bool("twosided", false)?,
+            power: Self::optional_positive(&ps, "power")?,
+        };
+        self.report_unused(&ps, &owner);
+        self.gs.area_light = Some(state);
+        Ok(())
+    }
+}

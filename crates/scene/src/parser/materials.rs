@@ -1,0 +1,299 @@
+//! `Material`, `MakeNamedMaterial`, `NamedMaterial` and `Texture`.
+//!
+//! - `"diffuse"`: `reflectance` (spectrum, default 0.5).
+//! - `"dielectric"`: `eta` (float or spectrum; default 1.5; named glasses become their
+//!   d-line index).
+//! - `"conductor"`: `reflectance` (an artist's mirror colour), else `eta` and `k`
+//!   (spectra; default copper, `metal-Cu-eta` / `metal-Cu-k`).
+//! - `"interface"` (also `""`, `"none"`): no surface.
+//! - Roughness (`roughness`, `uroughness`, `vroughness`) > 0 is read and rendered as
+//!   smooth, with a warning. Other material types render as diffuse 0.5 with a warning.
+
+use super::Parser;
+use super::spectrum_param::SpectrumUse;
+use super::state::with_defaults;
+use crate::desc::{ConductorDesc, MaterialDesc, MaterialId};
+use crate::error::{FileLoc, SceneError};
+use crate::named_spectra::{glass_eta, metal_spectrum};
+use crate::params::{ParamSet, ParamValue};
+use crate::spectrum::{interpolate, pairs_from_flat};
+use radiant_math::color::Rgb;
+
+/// pbrt-v4's material types that radiant replaces by diffuse 0.5.
+const FALLBACK_TYPES: [&str; 8] = [
+    "coateddiffuse",
+    "coatedconductor",
+    "diffusetransmission",
+    "hair",
+    "measured",
+    "mix",
+    "subsurface",
+    "thindielectric",
+];
+
+/// The d line (nm), where glass catalogues quote their index.
+const D_LINE_NM: f64 = 587.6;
+
+impl Parser {
+    /// `Material "type" params`: an anonymous material that becomes current.
+    pub(super) fn material(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (ty, _) = self.string_arg("Material")?;
+        let ps = with_defaults(self.param_list()?, &self.gs.defaults.material);
+        self.require_world("Material", loc)?;
+        let owner = format!("Material \"{ty}\"");
+        let m = self.build_material(&ty, &ps, loc, &owner)?;
+        self.report_unused(&ps, &owner);
+        self.gs.material = Some(self.push_material(m));
+        Ok(())
+    }
+
+    /// `MakeNamedMaterial "name" "string type" "…" params`.
+    pub(super) fn make_named_material(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (name, _) = self.string_arg("MakeNamedMaterial")?;
+        let ps = with_defaults(self.param_list()?, &self.gs.defaults.material);
+        self.require_world("MakeNamedMaterial", loc)?;
+        let owner = format!("MakeNamedMaterial \"{name}\"");
+        let ty = match ps.strings("type")? {
+            Some(([t], _)) => t.clone(),
+            Some((_, at)) => return Err(SceneError::at(at, "\"string type\" needs one value")),
+            None => {
+                return Err(SceneError::at(
+                    loc,
+                    format!("{owner} needs \"string type\""),
+                ));
+            }
+        };
+        if self.named_materials.contains_key(&name) {
+            return Err(SceneError::at(
+                loc,
+                format!("named material \"{name}\" is defined twice"),
+            ));
+        }
+        let m = self.build_material(&ty, &ps, loc, &owner)?;
+        self.report_unused(&ps, &owner);
+        let id = self.push_material(m);
+        self.named_materials.insert(name, id);
+        Ok(())
+    }
+
+    pub(super) fn named_material(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (name, _) = self.string_arg("NamedMaterial")?;
+        self.require_world("NamedMaterial", loc)?;
+        if name.is_empty() || name == "none" {
+            let id = self.push_material(MaterialDesc::Interface);
+            self.gs.material = Some(id);
+            return Ok(());
+        }
+        match self.named_materials.get(&name) {
+            Some(&id) => {
+                self.gs.material = Some(id);
+                Ok(())
+            }
+            None => Err(SceneError::at(
+                loc,
+                format!("unknown named material \"{name}\""),
+            )),
+        }
+    }
+
+    /// `Texture "name" "type" "class" params`: read past with one warning.
+    pub(super) fn texture(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (name, _) = self.string_arg("Texture")?;
+        self.string_arg("Texture")?;
+        let (class, _) = self.string_arg("Texture")?;
+        self.param_list()?.mark_all_used();
+        self.require_world("Texture", loc)?;
+        self.warn(
+            loc,
+            format!("Texture \"{name}\" (\"{class}\"): textures are not supported; materials using it fall back to constants"),
+        );
+        Ok(())
+    }
+
+    fn push_material(&mut self, m: MaterialDesc) -> MaterialId {
+        self.materials.push(m);
+        (self.materials.len() - 1) as MaterialId
+    }
+
+    /// The current material, creating pbrt's default (diffuse 0.5) on first need.
+    pub(super) fn current_material(&mut self) -> MaterialId {
+        if let Some(id) = self.gs.material {
+            return id;
+        }
+        match self.default_material {
+            Some(id) => id,
+            None => {
+                let id = self.push_material(MaterialDesc::Diffuse {
+                    reflectance: Rgb::splat(0.5),
+                });
+                self.default_material = Some(id);
+                id
+            }
+        }
+    }
+
+    fn build_material(
+        &mut self,
+        ty: &str,
+        ps: &ParamSet,
+        loc: &FileLoc,
+        owner: &str,
+    ) -> Result<MaterialDesc, SceneError> {
+        for unsupported in ["displacement", "normalmap"] {
+            if let Some(p) = ps.lookup(unsupported) {
+                let at = p.loc.clone();
+                self.warn(
+                    &at,
+                    format!("{owner}: \"{unsupported}\" is not supported; ignored"),
+                );
+            }
+        }
+        Ok(match ty {
+            "diffuse" => MaterialDesc::Diffuse {
+                reflectance: self.spectrum_or(
+                    ps,
+                    "reflectance",
+                    SpectrumUse::Albedo,
+                    Rgb::splat(0.5),
+                    owner,
+                )?,
+            },
+            "dielectric" => {
+                self.warn_if_rough(ps, loc, owner)?;
+                MaterialDesc::Dielectric {
+                    eta: self.dielectric_eta(ps, owner)?,
+                }
+            }
+            "conductor" => {
+                self.warn_if_rough(ps, loc, owner)?;
+                if ps.has("reflectance") {
+                    let r = self.spectrum_or(
+                        ps,
+                        "reflectance",
+                        SpectrumUse::Albedo,
+                        Rgb::WHITE,
+                        owner,
+                    )?;
+                    ps.lookup("eta");
+                    ps.lookup("k");
+                    MaterialDesc::Conductor(ConductorDesc::Reflectance(r))
+                } else {
+                    let cu_eta = metal_spectrum("metal-Cu-eta").expect("built-in table");
+                    let cu_k = metal_spectrum("metal-Cu-k").expect("built-in table");
+                    MaterialDesc::Conductor(ConductorDesc::EtaK {
+                        eta: self.spectrum_or(ps, "eta", SpectrumUse::Unbounded, cu_eta, owner)?,
+                        k: self.spectrum_or(ps, "k", SpectrumUse::Unbounded, cu_k, owner)?,
+                    })
+                }
+            }
+            "interface" | "" | "none" => MaterialDesc::Interface,
+            _ if FALLBACK_TYPES.contains(&ty) => {
+                ps.mark_all_used();
+                self.warn(loc, format!("{owner}: material type \"{ty}\" is not supported; rendered as diffuse with reflectance 0.5"));
+                MaterialDesc::Diffuse {
+                    reflectance: Rgb::splat(0.5),
+                }
+            }
+            _ => {
+                return Err(SceneError::at(
+                    loc,
+                    format!("unknown material type \"{ty}\""),
+                ));
+            }
+        })
+    }
+
+    /// pbrt-v4: `roughness` sets both `uroughness` and `vroughness` unless they are
+    /// given. radiant renders only smooth dielectrics and conductors.
+    fn warn_if_rough(
+        &mut self,
+        ps: &ParamSet,
+        loc: &FileLoc,
+        owner: &str,
+    ) -> Result<(), SceneError> {
+        ps.lookup("remaproughness");
+        let mut rough = false;
+        for name in ["roughness", "uroughness", "vroughness"] {
+            if let Some(p) = ps.lookup(name) {
+                rough |= match &p.value {
+                    ParamValue::Float(v) => v.iter().any(|&r| r != 0.0),
+                    ParamValue::Texture(_) => true,
+                    other => {
+                        return Err(SceneError::at(
+                            &p.loc,
+                            format!(
+                                "parameter \"{name}\" has type \"{}\", expected \"float\"",
+                                other.type_name()
+                            ),
+                        ));
+                    }
+                };
+            }
+        }
+        if rough {
+            self.warn(
+                loc,
+                format!("{owner}: rough surfaces are not supported; rendered as smooth"),
+            );
+        }
+        Ok(())
+    }
+
+    fn dielectric_eta(&mut self, ps: &ParamSet, owner: &str) -> Result<f32, SceneError> {
+        let Some(p) = ps.lookup("eta") else {
+            return Ok(1.5);
+        };
+        let loc = p.loc.clone();
+        let eta = match &p.value {
+            ParamValue::Float(v) if v.len() == 1 => v[0],
+            ParamValue::SpectrumNamed(v) if v.len() == 1 => {
+                let eta = glass_eta(&v[0])
+                    .ok_or_else(|| SceneError::at(&loc, format!("unknown glass \"{}\"", v[0])))?;
+                self.warn(
+                    &loc,
+                    format!(
+                        "{owner}: \"{}\" rendered without dispersion, eta = {eta}",
+                        v[0]
+                    ),
+                );
+                eta
+            }
+            ParamValue::SpectrumSamples(v) => {
+                let pairs = pairs_from_flat(v).ok_or_else(|| {
+                    SceneError::at(
+                        &loc,
+                        "spectrum \"eta\" needs finite (wavelength, value) pairs",
+                    )
+                })?;
+                let eta = interpolate(&pairs, D_LINE_NM) as f32;
+                self.warn(
+                    &loc,
+                    format!(
+                        "{owner}: spectral eta rendered without dispersion, eta = {eta} (587.6 nm)"
+                    ),
+                );
+                eta
+            }
+            ParamValue::Texture(_) => {
+                self.warn(
+                    &loc,
+                    format!("{owner}: textures are not supported; eta = 1.5"),
+                );
+                1.5
+            }
+            other => {
+                return Err(SceneError::at(
+                    &loc,
+                    format!(
+                        "parameter \"eta\" has type \"{}\" or the wrong count; expected one float or a spectrum",
+                        other.type_name()
+                    ),
+                ));
+            }
+        };
+        if !(eta.is_finite() && eta > 0.0) {
+            return Err(SceneError::at(&loc, format!("eta {eta} must be positive")));
+        }
+        Ok(eta)
+    }
+}

@@ -1,0 +1,332 @@
+//! Scene-wide options, before `WorldBegin`: camera, film, sampler, pixel filter,
+//! integrator (and the directives radiant accepts but has no use for).
+//!
+//! Parameters and defaults (pbrt-v4):
+//! - `Camera "perspective"`: `float fov` 90 (degrees, shorter image axis),
+//!   `float lensradius` 0, `float focaldistance` 1e6, `float screenwindow[4]`,
+//!   `float frameaspectratio`. `"orthographic"`: the same without `fov`.
+//!   `"realistic"`: `string lensfile` (required, relative to the scene file),
+//!   `float aperturediameter` 1.0 mm, `float focusdistance` 10.0 m.
+//! - `Film "rgb"`: `integer xresolution` 1280, `yresolution` 720,
+//!   `string filename` "pbrt.exr", `float diagonal` 35 mm, `float iso` 100.
+//! - `Sampler`: `integer pixelsamples` 16, `integer seed` 0; `"stratified"` uses
+//!   `xsamples` × `ysamples` (4 × 4).
+//! - `PixelFilter`: `float xradius`/`yradius`; box 0.5, gaussian 1.5 (`sigma` 0.5),
+//!   triangle 2.
+
+use glam::Vec2;
+
+use super::Parser;
+use crate::desc::*;
+use crate::error::{FileLoc, SceneError};
+use crate::params::ParamSet;
+
+impl Parser {
+    pub(super) fn camera(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (name, _) = self.string_arg("Camera")?;
+        let ps = self.param_list()?;
+        self.require_options("Camera", loc)?;
+        let camera_from_world = self.gs.ctm;
+        self.named_coord_systems
+            .insert("camera".into(), camera_from_world.inverse());
+        let kind = match name.as_str() {
+            "perspective" => {
+                let fov_deg = ps.finite_float("fov", 90.0)?;
+                if !(fov_deg > 0.0 && fov_deg < 180.0) {
+                    let at = &ps.lookup("fov").map_or(loc, |p| &p.loc).clone();
+                    return Err(SceneError::at(
+                        at,
+                        format!("fov {fov_deg} must lie in (0, 180) degrees"),
+                    ));
+                }
+                CameraKind::Perspective {
+                    fov_deg,
+                    lens_radius: ps.finite_float("lensradius", 0.0)?,
+                    focal_distance: ps.finite_float("focaldistance", 1e6)?,
+                    screen_window: screen_window(&ps)?,
+                }
+            }
+            "orthographic" => CameraKind::Orthographic {
+                lens_radius: ps.finite_float("lensradius", 0.0)?,
+                focal_distance: ps.finite_float("focaldistance", 1e6)?,
+                screen_window: screen_window(&ps)?,
+            },
+            "realistic" => {
+                let lens = ps.string("lensfile", String::new())?;
+                let at = ps.lookup("lensfile").map_or(loc, |p| &p.loc).clone();
+                if lens.is_empty() {
+                    return Err(SceneError::at(
+                        &at,
+                        "Camera \"realistic\" needs \"string lensfile\"",
+                    ));
+                }
+                let lens_file = self.resolve_path(&lens);
+                if !lens_file.is_file() {
+                    return Err(SceneError::at(
+                        &at,
+                        format!("lens file '{}' not found", lens_file.display()),
+                    ));
+                }
+                if ps.has("aperture") {
+                    ps.lookup("aperture");
+                    self.warn(&at, "Camera \"realistic\": custom aperture shapes are not supported; a circular stop is used");
+                }
+                CameraKind::Realistic {
+                    lens_file,
+                    aperture_diameter_mm: ps.finite_float("aperturediameter", 1.0)?,
+                    focus_distance: ps.finite_float("focusdistance", 10.0)?,
+                }
+            }
+            "spherical" => {
+                ps.mark_all_used();
+                self.warn(
+                    loc,
+                    "Camera \"spherical\" is not supported; using a perspective camera with fov 90",
+                );
+                CameraKind::Perspective {
+                    fov_deg: 90.0,
+                    lens_radius: 0.0,
+                    focal_distance: 1e6,
+                    screen_window: None,
+                }
+            }
+            _ => return Err(SceneError::at(loc, format!("unknown camera \"{name}\""))),
+        };
+        self.report_unused(&ps, &format!("Camera \"{name}\""));
+        self.camera = Some(CameraDesc {
+            camera_from_world,
+            kind,
+            loc: loc.clone(),
+        });
+        Ok(())
+    }
+
+    pub(super) fn film(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (name, _) = self.string_arg("Film")?;
+        let ps = self.param_list()?;
+        self.require_options("Film", loc)?;
+        match name.as_str() {
+            "rgb" => {}
+            "gbuffer" | "spectral" => {
+                ps.lookup("coordinatesystem");
+                for p in ["nbuckets", "lambdamin", "lambdamax"] {
+                    ps.lookup(p);
+                }
+                self.warn(
+                    loc,
+                    format!("Film \"{name}\" is rendered as an \"rgb\" film"),
+                );
+            }
+            _ => return Err(SceneError::at(loc, format!("unknown film \"{name}\""))),
+        }
+        let resolution = |key: &str, default: u32| -> Result<u32, SceneError> {
+            let v = ps.count(key, default)?;
+            if v == 0 {
+                let at = &ps.lookup(key).map_or(loc, |p| &p.loc).clone();
+                return Err(SceneError::at(at, format!("{key} must be positive")));
+            }
+            Ok(v)
+        };
+        let film = FilmDesc {
+            xresolution: resolution("xresolution", 1280)?,
+            yresolution: resolution("yresolution", 720)?,
+            filename: Some(ps.string("filename", "pbrt.exr".into())?),
+            diagonal_mm: ps.finite_float("diagonal", 35.0)?,
+            iso: ps.finite_float("iso", 100.0)?,
+            loc: loc.clone(),
+        };
+        let sensor_is_default = matches!(ps.strings("sensor")?, Some(([s], _)) if s == "cie1931");
+        let white_balance_off = matches!(ps.floats("whitebalance")?, Some(([w], _)) if *w == 0.0);
+        for (key, skip) in [
+            ("sensor", sensor_is_default),
+            ("whitebalance", white_balance_off),
+            ("savefp16", false),
+            ("maxcomponentvalue", false),
+            ("exposuretime", false),
+            ("cropwindow", false),
+            ("pixelbounds", false),
+        ] {
+            if let Some(p) = ps.lookup(key)
+                && !skip
+            {
+                let at = p.loc.clone();
+                self.warn(
+                    &at,
+                    format!("Film: parameter \"{key}\" is not supported; ignored"),
+                );
+            }
+        }
+        self.report_unused(&ps, &format!("Film \"{name}\""));
+        self.film = Some(film);
+        Ok(())
+    }
+
+    pub(super) fn sampler(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (name, _) = self.string_arg("Sampler")?;
+        let ps = self.param_list()?;
+        self.require_options("Sampler", loc)?;
+        let kind = if name == "independent" {
+            SamplerKind::Independent
+        } else {
+            SamplerKind::Sobol
+        };
+        if name != "independent" && name != "sobol" {
+            self.warn(
+                loc,
+                format!("Sampler \"{name}\": rendered with radiant's Owen-scrambled Sobol sampler"),
+            );
+        }
+        // pbrt's randomization choices and stratified jitter have no counterpart.
+        ps.lookup("randomization");
+        ps.lookup("jitter");
+        let pixel_samples = if name == "stratified" {
+            ps.count("xsamples", 4)?
+                .checked_mul(ps.count("ysamples", 4)?)
+                .unwrap_or(0)
+        } else {
+            ps.count("pixelsamples", 16)?
+        };
+        if pixel_samples == 0 {
+            return Err(SceneError::at(
+                loc,
+                "Sampler: the number of samples per pixel must be positive (and fit 32 bits)",
+            ));
+        }
+        let seed = ps.int("seed", 0)?;
+        self.report_unused(&ps, &format!("Sampler \"{name}\""));
+        self.sampler = Some(SamplerDesc {
+            kind,
+            pixel_samples,
+            // Negative seeds are valid in pbrt; keep their bits.
+            seed: u64::from(seed as u32),
+            loc: loc.clone(),
+        });
+        Ok(())
+    }
+
+    pub(super) fn pixel_filter(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (name, _) = self.string_arg("PixelFilter")?;
+        let ps = self.param_list()?;
+        self.require_options("PixelFilter", loc)?;
+        let (kind, default_radius) = match name.as_str() {
+            "box" => (FilterKind::Box, 0.5),
+            "triangle" => (FilterKind::Triangle, 2.0),
+            "gaussian" => (
+                FilterKind::Gaussian {
+                    sigma: ps.finite_float("sigma", 0.5)?,
+                },
+                1.5,
+            ),
+            _ => {
+                ps.mark_all_used();
+                self.warn(loc, format!("PixelFilter \"{name}\" is not supported; using a gaussian filter (sigma 0.5, radius 1.5)"));
+                self.filter = Some(FilterDesc {
+                    kind: FilterKind::Gaussian { sigma: 0.5 },
+                    radius: Vec2::splat(1.5),
+                    loc: loc.clone(),
+                });
+                return Ok(());
+            }
+        };
+        let radius = Vec2::new(
+            ps.finite_float("xradius", default_radius)?,
+            ps.finite_float("yradius", default_radius)?,
+        );
+        if radius.min_element() <= 0.0 {
+            return Err(SceneError::at(loc, "PixelFilter: radii must be positive"));
+        }
+        if let FilterKind::Gaussian { sigma } = kind
+            && sigma <= 0.0
+        {
+            return Err(SceneError::at(loc, "PixelFilter: sigma must be positive"));
+        }
+        self.report_unused(&ps, &format!("PixelFilter \"{name}\""));
+        self.filter = Some(FilterDesc {
+            kind,
+            radius,
+            loc: loc.clone(),
+        });
+        Ok(())
+    }
+
+    /// The integrator's parameters stay unread here: the integrator the lead builds
+    /// from them reads them and reports the unused ones.
+    pub(super) fn integrator(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (name, _) = self.string_arg("Integrator")?;
+        let params = self.param_list()?;
+        self.require_options("Integrator", loc)?;
+        self.integrator = Some(IntegratorDesc {
+            name,
+            params,
+            loc: loc.clone(),
+        });
+        Ok(())
+    }
+
+    /// `Accelerator`: radiant always builds its own BVH; accepted silently.
+    pub(super) fn accelerator(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        self.string_arg("Accelerator")?;
+        self.param_list()?.mark_all_used();
+        self.require_options("Accelerator", loc)
+    }
+
+    pub(super) fn color_space(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (name, _) = self.string_arg("ColorSpace")?;
+        if name != "srgb" {
+            self.warn(
+                loc,
+                format!(
+                    "ColorSpace \"{name}\" is not supported; RGB values are read as linear sRGB"
+                ),
+            );
+        }
+        Ok(())
+    }
+
+    pub(super) fn option(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let ps: ParamSet = self.param_list()?;
+        for p in &ps.params {
+            self.warnings.push(crate::error::Warning {
+                loc: p.loc.clone(),
+                message: format!("Option \"{}\" is ignored", p.name),
+            });
+        }
+        if ps.params.is_empty() {
+            return Err(SceneError::at(loc, "Option needs a parameter"));
+        }
+        Ok(())
+    }
+}
+
+/// `screenwindow`, or the window implied by `frameaspectratio` (pbrt: [-a, a] × [-1, 1]
+/// for a > 1, else [-1, 1] × [-1/a, 1/a]); `None` leaves it to the film's aspect ratio.
+fn screen_window(ps: &ParamSet) -> Result<Option<[f32; 4]>, SceneError> {
+    if let Some((values, at)) = ps.floats("screenwindow")? {
+        let [a, b, c, d] = values else {
+            return Err(SceneError::at(
+                at,
+                format!("screenwindow needs 4 numbers, found {}", values.len()),
+            ));
+        };
+        if values.iter().any(|v| !v.is_finite()) || a >= b || c >= d {
+            return Err(SceneError::at(
+                at,
+                "screenwindow must be finite with xmin < xmax and ymin < ymax",
+            ));
+        }
+        ps.lookup("frameaspectratio");
+        return Ok(Some([*a, *b, *c, *d]));
+    }
+    match ps.floats("frameaspectratio")? {
+        None => Ok(None),
+        Some((&[a], _)) if a.is_finite() && a > 0.0 => Ok(Some(if a > 1.0 {
+            [-a, a, -1.0, 1.0]
+        } else {
+            [-1.0, 1.0, -1.0 / a, 1.0 / a]
+        })),
+        Some((_, at)) => Err(SceneError::at(
+            at,
+            "frameaspectratio must be one positive number",
+        )),
+    }
+}

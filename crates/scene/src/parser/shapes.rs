@@ -1,0 +1,386 @@
+//! `Shape` directives.
+//!
+//! - `"trianglemesh"`: `point3 P`, `integer indices` (may be omitted for exactly three
+//!   vertices), `normal N`, `point2 uv`; `vector3 S` and `integer faceIndices` are read
+//!   and ignored with a warning.
+//! - `"bilinearmesh"`: `P`, `indices` (four per patch: p00 p10 p01 p11; may be omitted
+//!   for exactly four vertices), `N`, `uv`.
+//! - `"plymesh"`, `"objmesh"`: `string filename`, relative to the scene file.
+//! - `"sphere"`: `radius` 1, `zmin` -radius, `zmax` radius, `phimax` 360.
+//! - `"disk"`: `height` 0, `radius` 1, `innerradius` 0, `phimax` 360.
+//!
+//! Each shape takes the CTM as its render-from-object transform, the current material,
+//! `ReverseOrientation` and the current area light.
+
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+
+use super::Parser;
+use super::state::with_defaults;
+use crate::desc::{AreaLightDesc, Geometry, ShapeDesc};
+use crate::error::{FileLoc, SceneError};
+use crate::mesh::{MeshData, first_non_finite2, first_non_finite3, first_out_of_range};
+use crate::params::{ParamSet, ParamValue};
+use crate::{obj, ply};
+
+/// pbrt-v4 shapes radiant does not render.
+const SKIPPED_SHAPES: [&str; 7] = [
+    "curve",
+    "cylinder",
+    "loopsubdiv",
+    "cone",
+    "paraboloid",
+    "hyperboloid",
+    "nurbs",
+];
+
+impl Parser {
+    pub(super) fn shape(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
+        let (name, _) = self.string_arg("Shape")?;
+        let ps = with_defaults(self.param_list()?, &self.gs.defaults.shape);
+        self.require_world("Shape", loc)?;
+        let owner = format!("Shape \"{name}\"");
+        if let Some(p) = ps.lookup("alpha") {
+            let at = p.loc.clone();
+            self.warn(
+                &at,
+                format!("{owner}: alpha cut-outs are not supported; the shape is opaque"),
+            );
+        }
+        ps.lookup("emissionfilename");
+        let geometries = match name.as_str() {
+            "trianglemesh" => vec![self.triangle_mesh(&ps, loc, &owner)?],
+            "bilinearmesh" => vec![bilinear_mesh(&ps, loc)?],
+            "plymesh" | "objmesh" => self.mesh_file(&name, &ps, loc, &owner)?,
+            "sphere" => vec![sphere(&ps, loc)?],
+            "disk" => vec![disk(&ps, loc)?],
+            _ if SKIPPED_SHAPES.contains(&name.as_str()) => {
+                ps.mark_all_used();
+                self.warn(loc, format!("{owner} is not supported; shape skipped"));
+                return Ok(());
+            }
+            _ => return Err(SceneError::at(loc, format!("unknown shape \"{name}\""))),
+        };
+        self.report_unused(&ps, &owner);
+        self.add_shapes(geometries, loc);
+        Ok(())
+    }
+
+    fn add_shapes(&mut self, geometries: Vec<Geometry>, loc: &FileLoc) {
+        let render_from_object = self.gs.ctm;
+        let material = self.current_material();
+        let area_light = match (self.gs.area_light.clone(), self.object.is_some()) {
+            (None, _) => None,
+            (Some(_), true) => {
+                if !self.object_area_light_warned {
+                    self.object_area_light_warned = true;
+                    self.warn(
+                        loc,
+                        "area lights inside object definitions lose their emission (as in pbrt-v4)",
+                    );
+                }
+                None
+            }
+            (Some(al), false) => {
+                let mut l = al.l;
+                if let Some(power) = al.power {
+                    // Φ = π A L per emitting side for a Lambertian emitter.
+                    let area: f32 = geometries
+                        .iter()
+                        .map(|g| g.surface_area(&render_from_object.m))
+                        .sum();
+                    let sides = if al.two_sided { 2.0 } else { 1.0 };
+                    let y = l.luminance();
+                    if area > 0.0 && y > 0.0 {
+                        l *= power / (radiant_math::PI * area * sides * y);
+                    } else {
+                        self.warn(
+                            loc,
+                            "area light \"power\" ignored: the shape has no area or L is black",
+                        );
+                    }
+                }
+                Some(AreaLightDesc {
+                    l,
+                    two_sided: al.two_sided,
+                })
+            }
+        };
+        let shapes = geometries.into_iter().map(|geometry| ShapeDesc {
+            geometry,
+            render_from_object,
+            reverse_orientation: self.gs.reverse_orientation,
+            material,
+            area_light: area_light.clone(),
+            loc: loc.clone(),
+        });
+        match &mut self.object {
+            Some(object) => object.shapes.extend(shapes),
+            None => self.shapes.extend(shapes),
+        }
+    }
+
+    fn triangle_mesh(
+        &mut self,
+        ps: &ParamSet,
+        loc: &FileLoc,
+        owner: &str,
+    ) -> Result<Geometry, SceneError> {
+        let (positions, indices, normals, uvs) = mesh_params(ps, loc, 3)?;
+        for extra in ["S", "faceIndices"] {
+            if let Some(p) = ps.lookup(extra) {
+                let at = p.loc.clone();
+                self.warn(&at, format!("{owner}: \"{extra}\" is read but not used"));
+            }
+        }
+        Ok(Geometry::TriangleMesh {
+            positions,
+            indices,
+            normals,
+            uvs,
+        })
+    }
+
+    fn mesh_file(
+        &mut self,
+        kind: &str,
+        ps: &ParamSet,
+        loc: &FileLoc,
+        owner: &str,
+    ) -> Result<Vec<Geometry>, SceneError> {
+        let Some((names, at)) = ps.strings("filename")? else {
+            return Err(SceneError::at(
+                loc,
+                format!("{owner} needs \"string filename\""),
+            ));
+        };
+        let [written] = names else {
+            return Err(SceneError::at(at, "\"filename\" needs one value"));
+        };
+        let at = at.clone();
+        let path = self.resolve_path(written);
+        for unsupported in ["displacement", "edgelength"] {
+            if let Some(p) = ps.lookup(unsupported) {
+                let ploc = p.loc.clone();
+                self.warn(
+                    &ploc,
+                    format!("{owner}: \"{unsupported}\" is not supported; ignored"),
+                );
+            }
+        }
+        let read = if kind == "plymesh" {
+            ply::read_ply(&path)
+        } else {
+            obj::read_obj(&path)
+        };
+        let mesh = read.map_err(|e| at_param(e, &at, &path))?;
+        if mesh.polygons_split > 0 {
+            self.warn(
+                &at,
+                format!(
+                    "{owner}: {} polygons with more than 4 vertices split into triangle fans",
+                    mesh.polygons_split
+                ),
+            );
+        }
+        if mesh.faces_skipped > 0 {
+            self.warn(
+                &at,
+                format!(
+                    "{owner}: {} faces with fewer than 3 vertices skipped",
+                    mesh.faces_skipped
+                ),
+            );
+        }
+        Ok(mesh_geometries(mesh))
+    }
+}
+
+/// A mesh file's error, moved to the parameter that named the file.
+fn at_param(e: SceneError, at: &FileLoc, path: &Path) -> SceneError {
+    match e {
+        SceneError::File { message, .. } => {
+            SceneError::at(at, format!("{}: {message}", path.display()))
+        }
+        other => other,
+    }
+}
+
+fn mesh_geometries(mesh: MeshData) -> Vec<Geometry> {
+    let mut out = Vec::new();
+    if !mesh.triangles.is_empty() {
+        out.push(Geometry::TriangleMesh {
+            positions: mesh.positions.clone(),
+            indices: mesh.triangles,
+            normals: mesh.normals.clone(),
+            uvs: mesh.uvs.clone(),
+        });
+    }
+    if !mesh.quads.is_empty() {
+        out.push(Geometry::BilinearMesh {
+            positions: mesh.positions,
+            indices: mesh.quads,
+            normals: mesh.normals,
+            uvs: mesh.uvs,
+        });
+    }
+    out
+}
+
+type MeshParams = (Vec<Vec3>, Vec<u32>, Option<Vec<Vec3>>, Option<Vec<Vec2>>);
+
+/// `P`, `indices` (`per` per primitive), `N`, `uv`, validated.
+fn mesh_params(ps: &ParamSet, loc: &FileLoc, per: usize) -> Result<MeshParams, SceneError> {
+    let Some((positions, p_loc)) = ps.point3s("P")? else {
+        return Err(SceneError::at(loc, "mesh needs \"point3 P\""));
+    };
+    let n = positions.len();
+    if let Some((i, v)) = first_non_finite3(positions) {
+        return Err(SceneError::at(
+            p_loc,
+            format!("\"P\": vertex {i} is not finite ({v})"),
+        ));
+    }
+    let indices: Vec<u32> = match ps.ints("indices")? {
+        Some((ix, i_loc)) => {
+            if ix.len() % per != 0 || ix.is_empty() {
+                return Err(SceneError::at(
+                    i_loc,
+                    format!(
+                        "\"indices\": {} values is not a positive multiple of {per}",
+                        ix.len()
+                    ),
+                ));
+            }
+            let ix: Vec<u32> = ix
+                .iter()
+                .map(|&i| u32::try_from(i).unwrap_or(u32::MAX))
+                .collect();
+            if let Some((k, i)) = first_out_of_range(&ix, n) {
+                let shown = if i == u32::MAX {
+                    "a negative index".to_string()
+                } else {
+                    format!("index {i}")
+                };
+                return Err(SceneError::at(
+                    i_loc,
+                    format!("\"indices\": entry {k} is {shown}, but there are {n} vertices"),
+                ));
+            }
+            ix
+        }
+        None if n == per => (0..per as u32).collect(),
+        None => {
+            return Err(SceneError::at(
+                loc,
+                format!("mesh needs \"integer indices\" unless it has exactly {per} vertices"),
+            ));
+        }
+    };
+    let normals = match ps.normals("N")? {
+        None => None,
+        Some((normals, n_loc)) => {
+            if normals.len() != n {
+                return Err(SceneError::at(
+                    n_loc,
+                    format!("\"N\": {} normals for {n} vertices", normals.len()),
+                ));
+            }
+            if let Some((i, v)) = first_non_finite3(normals) {
+                return Err(SceneError::at(
+                    n_loc,
+                    format!("\"N\": normal {i} is not finite ({v})"),
+                ));
+            }
+            Some(normals.to_vec())
+        }
+    };
+    let uvs = uv_param(ps, n)?;
+    Ok((positions.to_vec(), indices, normals, uvs))
+}
+
+/// `point2 uv`, or pbrt-v3's `float uv` / `float st` as flat pairs.
+fn uv_param(ps: &ParamSet, n: usize) -> Result<Option<Vec<Vec2>>, SceneError> {
+    let Some(p) = ps.lookup("uv").or_else(|| ps.lookup("st")) else {
+        return Ok(None);
+    };
+    let uvs: Vec<Vec2> = match &p.value {
+        ParamValue::Point2(v) | ParamValue::Vector2(v) => v.clone(),
+        ParamValue::Float(v) if v.len() % 2 == 0 => {
+            v.chunks_exact(2).map(Vec2::from_slice).collect()
+        }
+        other => {
+            return Err(SceneError::at(
+                &p.loc,
+                format!(
+                    "\"{}\" has type \"{}\", expected \"point2\"",
+                    p.name,
+                    other.type_name()
+                ),
+            ));
+        }
+    };
+    if uvs.len() != n {
+        return Err(SceneError::at(
+            &p.loc,
+            format!("\"{}\": {} uvs for {n} vertices", p.name, uvs.len()),
+        ));
+    }
+    if let Some((i, v)) = first_non_finite2(&uvs) {
+        return Err(SceneError::at(
+            &p.loc,
+            format!("\"{}\": uv {i} is not finite ({v})", p.name),
+        ));
+    }
+    Ok(Some(uvs))
+}
+
+fn bilinear_mesh(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
+    let (positions, indices, normals, uvs) = mesh_params(ps, loc, 4)?;
+    Ok(Geometry::BilinearMesh {
+        positions,
+        indices,
+        normals,
+        uvs,
+    })
+}
+
+fn positive(
+    ps: &ParamSet,
+    name: &str,
+    default: f32,
+    allow_zero: bool,
+    loc: &FileLoc,
+) -> Result<f32, SceneError> {
+    let v = ps.finite_float(name, default)?;
+    if v < 0.0 || (v == 0.0 && !allow_zero) {
+        let at = ps.lookup(name).map_or(loc, |p| &p.loc);
+        return Err(SceneError::at(
+            at,
+            format!("\"{name}\" must be positive, got {v}"),
+        ));
+    }
+    Ok(v)
+}
+
+fn sphere(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
+    let radius = positive(ps, "radius", 1.0, false, loc)?;
+    let z_min = ps.finite_float("zmin", -radius)?.clamp(-radius, radius);
+    let z_max = ps.finite_float("zmax", radius)?.clamp(-radius, radius);
+    Ok(Geometry::Sphere {
+        radius,
+        z_min: z_min.min(z_max),
+        z_max: z_min.max(z_max),
+        phi_max_deg: ps.finite_float("phimax", 360.0)?.clamp(0.0, 360.0),
+    })
+}
+
+fn disk(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
+    Ok(Geometry::Disk {
+        height: ps.finite_float("height", 0.0)?,
+        radius: positive(ps, "radius", 1.0, false, loc)?,
+        inner_radius: positive(ps, "innerradius", 0.0, true, loc)?,
+        phi_max_deg: ps.finite_float("phimax", 360.0)?.clamp(0.0, 360.0),
+    })
+}

@@ -1,0 +1,184 @@
+//! The malformed-scene corpus: every file under `tests/scenes/malformed/` must fail with
+//! an error at the exact `file:line:column` of its fault, and never panic.
+
+use std::path::PathBuf;
+
+use radiant_scene::parse_file;
+
+fn corpus(name: &str) -> PathBuf {
+    radiant_testkit::repo_path("tests/scenes/malformed").join(name)
+}
+
+/// (scene file, file the error must name (relative to the corpus), line, column,
+/// words the message must contain).
+const CASES: &[(&str, &str, u32, u32, &[&str])] = &[
+    (
+        "unknown_directive.pbrt",
+        "unknown_directive.pbrt",
+        4,
+        3,
+        &["unknown directive 'Shaep'"],
+    ),
+    (
+        "bad_number.pbrt",
+        "bad_number.pbrt",
+        2,
+        33,
+        &["bad number '1.2.3'"],
+    ),
+    (
+        "unterminated_string.pbrt",
+        "unterminated_string.pbrt",
+        2,
+        15,
+        &["unterminated string"],
+    ),
+    (
+        "missing_plymesh.pbrt",
+        "missing_plymesh.pbrt",
+        3,
+        21,
+        &["does-not-exist.ply", "cannot open"],
+    ),
+    (
+        "missing_include.pbrt",
+        "missing_include.pbrt",
+        3,
+        1,
+        &["no-such-file.pbrt", "cannot read included file"],
+    ),
+    (
+        "wrong_param_type.pbrt",
+        "wrong_param_type.pbrt",
+        2,
+        22,
+        &["\"fov\"", "expected \"float\""],
+    ),
+    (
+        "unknown_named_material.pbrt",
+        "unknown_named_material.pbrt",
+        3,
+        1,
+        &["unknown named material \"whit\""],
+    ),
+    (
+        "index_count.pbrt",
+        "index_count.pbrt",
+        4,
+        5,
+        &["indices", "multiple of 3"],
+    ),
+    (
+        "nan_vertex.pbrt",
+        "nan_vertex.pbrt",
+        4,
+        5,
+        &["\"P\"", "vertex 1", "not finite"],
+    ),
+    (
+        "attribute_end.pbrt",
+        "attribute_end.pbrt",
+        4,
+        3,
+        &["AttributeEnd without a matching AttributeBegin"],
+    ),
+    (
+        "nan_in_ply.pbrt",
+        "nan_in_ply.pbrt",
+        2,
+        17,
+        &["nan.ply", "vertex 2", "non-finite"],
+    ),
+    (
+        "error_in_include.pbrt",
+        "inc/broken.pbrt",
+        2,
+        16,
+        &["\"radius\" must be positive"],
+    ),
+    (
+        "index_out_of_range.pbrt",
+        "index_out_of_range.pbrt",
+        3,
+        22,
+        &["index 3", "3 vertices"],
+    ),
+    (
+        "unclosed_attribute.pbrt",
+        "unclosed_attribute.pbrt",
+        2,
+        1,
+        &["AttributeBegin without a matching end"],
+    ),
+    (
+        "shape_before_world.pbrt",
+        "shape_before_world.pbrt",
+        2,
+        1,
+        &["only allowed after WorldBegin"],
+    ),
+    (
+        "integer_expected.pbrt",
+        "integer_expected.pbrt",
+        1,
+        36,
+        &["64.5 is not a 32-bit integer"],
+    ),
+    (
+        "normal_count.pbrt",
+        "normal_count.pbrt",
+        3,
+        5,
+        &["2 normals for 3 vertices"],
+    ),
+];
+
+#[test]
+fn every_malformed_scene_fails_at_its_fault() {
+    for (scene, blamed, line, column, words) in CASES {
+        let result = std::panic::catch_unwind(|| parse_file(&corpus(scene)));
+        let Ok(result) = result else {
+            panic!("{scene}: the parser panicked");
+        };
+        let message = match result {
+            Ok(_) => panic!("{scene}: parsed without error"),
+            Err(e) => e.to_string(),
+        };
+        let expected_loc = format!("{}:{line}:{column}: error:", corpus(blamed).display());
+        assert!(
+            message.starts_with(&expected_loc),
+            "{scene}: expected the error at {expected_loc}, got: {message}"
+        );
+        for w in *words {
+            assert!(
+                message.contains(w),
+                "{scene}: message lacks \"{w}\": {message}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_corpus_has_no_untested_file() {
+    let dir = corpus("");
+    let mut files: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".pbrt"))
+        .collect();
+    files.sort();
+    let mut tested: Vec<String> = CASES.iter().map(|c| c.0.to_string()).collect();
+    tested.sort();
+    assert_eq!(files, tested);
+}
+
+#[test]
+fn an_unreadable_scene_names_its_path() {
+    let path = corpus("no-such-scene.pbrt");
+    let e = parse_file(&path).unwrap_err().to_string();
+    assert!(
+        e.starts_with(&format!("{}: error: cannot read scene", path.display())),
+        "{e}"
+    );
+}

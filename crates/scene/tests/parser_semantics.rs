@@ -1,0 +1,376 @@
+//! Defaults, materials, lights and warnings of the pbrt-v4 reader.
+
+use std::path::Path;
+
+use radiant_math::color::Rgb;
+use radiant_math::{PI, Vec2, Vec3};
+use radiant_scene::named_spectra::metal_spectrum;
+use radiant_scene::spectrum::blackbody_rgb;
+use radiant_scene::{
+    CameraKind, ConductorDesc, FilterKind, Geometry, LightDesc, MaterialDesc, SamplerKind,
+    SceneDesc, parse_str,
+};
+
+fn parse(text: &str) -> SceneDesc {
+    parse_str(text, "t.pbrt", Path::new(".")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn err(text: &str) -> String {
+    parse_str(text, "t.pbrt", Path::new("."))
+        .unwrap_err()
+        .to_string()
+}
+
+/// Relative tolerance for values that pass through a few f32 operations.
+fn close(a: f32, b: f32) -> bool {
+    (a - b).abs() <= 1e-5 * a.abs().max(b.abs()).max(1.0)
+}
+
+#[test]
+fn absent_directives_take_pbrt_v4_defaults() {
+    let s = parse("WorldBegin\n");
+    assert!(s.camera.camera_from_world.is_identity());
+    assert!(matches!(
+        s.camera.kind,
+        CameraKind::Perspective {
+            fov_deg: 90.0,
+            lens_radius: 0.0,
+            ..
+        }
+    ));
+    assert_eq!((s.film.xresolution, s.film.yresolution), (1280, 720));
+    assert_eq!(s.film.filename.as_deref(), Some("pbrt.exr"));
+    assert_eq!(
+        (s.sampler.kind, s.sampler.pixel_samples),
+        (SamplerKind::Sobol, 16)
+    );
+    assert_eq!(s.filter.kind, FilterKind::Gaussian { sigma: 0.5 });
+    assert_eq!(s.filter.radius, Vec2::splat(1.5));
+    assert_eq!(s.integrator.name, "volpath");
+    assert_eq!(s.integrator.params.int("maxdepth", 0).unwrap(), 5);
+    assert!(s.warnings.is_empty());
+}
+
+#[test]
+fn options_are_read_with_their_defaults() {
+    let s = parse(
+        "Camera \"perspective\" \"float fov\" 45 \"float frameaspectratio\" 2\n\
+         Film \"rgb\" \"integer xresolution\" 300 \"float iso\" 400\n\
+         Sampler \"stratified\" \"integer xsamples\" 3 \"integer ysamples\" 5 \"bool jitter\" false\n\
+         PixelFilter \"triangle\" \"float yradius\" 1\nIntegrator \"bdpt\" \"integer maxdepth\" 7\nWorldBegin\n",
+    );
+    match s.camera.kind {
+        CameraKind::Perspective {
+            fov_deg,
+            screen_window,
+            ..
+        } => {
+            assert_eq!(fov_deg, 45.0);
+            assert_eq!(screen_window, Some([-2.0, 2.0, -1.0, 1.0]));
+        }
+        k => panic!("{k:?}"),
+    }
+    assert_eq!(
+        (s.film.xresolution, s.film.yresolution, s.film.iso),
+        (300, 720, 400.0)
+    );
+    assert_eq!(s.sampler.pixel_samples, 15);
+    assert_eq!(s.filter.radius, Vec2::new(2.0, 1.0));
+    // The integrator's parameters are left for the integrator to use and report.
+    assert!(s.warnings.iter().all(|w| !w.message.contains("maxdepth")));
+    assert_eq!(
+        s.warnings.len(),
+        1,
+        "stratified → Sobol note: {:?}",
+        s.warnings
+    );
+}
+
+#[test]
+fn realistic_camera_resolves_its_lens_file_from_the_scene_folder() {
+    let lenses = radiant_testkit::shared_root().join("data");
+    let s = parse_str(
+        "Camera \"realistic\" \"string lensfile\" \"lenses/dgauss.50mm.dat\" \"float focusdistance\" 2\nWorldBegin\n",
+        "t.pbrt",
+        &lenses,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    match s.camera.kind {
+        CameraKind::Realistic {
+            lens_file,
+            aperture_diameter_mm,
+            focus_distance,
+        } => {
+            assert_eq!(lens_file, lenses.join("lenses/dgauss.50mm.dat"));
+            assert_eq!((aperture_diameter_mm, focus_distance), (1.0, 2.0));
+        }
+        k => panic!("{k:?}"),
+    }
+    let e = err("Camera \"realistic\"\n  \"string lensfile\" \"nope.dat\"\n");
+    assert!(e.starts_with("t.pbrt:2:3: error: lens file"), "{e}");
+}
+
+#[test]
+fn unused_and_unsupported_parameters_warn_with_their_location() {
+    let s = parse(
+        "Film \"rgb\" \"float whitebalance\" 5500 \"bool savefp16\" true\nWorldBegin\n\
+         Shape \"sphere\" \"float radius\" 2\n      \"float radisu\" 3\n",
+    );
+    let msgs: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(msgs.len(), 3, "{msgs:#?}");
+    assert!(msgs[0].starts_with("t.pbrt:1:12: warning: Film: parameter \"whitebalance\""));
+    assert!(msgs[1].starts_with("t.pbrt:1:38: warning: Film: parameter \"savefp16\""));
+    assert_eq!(
+        msgs[2],
+        "t.pbrt:4:7: warning: parameter \"float radisu\" is not used by Shape \"sphere\""
+    );
+}
+
+#[test]
+fn materials_map_to_radiant_materials() {
+    let s = parse(
+        "WorldBegin\n\
+         Material \"diffuse\"\n\
+         Material \"diffuse\" \"rgb reflectance\" [ 0.2 0.4 0.6 ]\n\
+         Material \"dielectric\" \"spectrum eta\" \"glass-BK7\"\n\
+         Material \"dielectric\" \"float eta\" 1.33 \"float roughness\" 0.1\n\
+         Material \"conductor\"\n\
+         Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\"\n\
+         Material \"conductor\" \"rgb reflectance\" [ 0.9 0.9 0.9 ]\n\
+         Material \"coateddiffuse\" \"rgb reflectance\" [ 1 0 0 ]\n\
+         Material \"diffuse\" \"texture reflectance\" \"checks\"\n\
+         Material \"interface\"\n",
+    );
+    let named = |n: &str| metal_spectrum(n).unwrap();
+    let expected = vec![
+        MaterialDesc::Diffuse {
+            reflectance: Rgb::splat(0.5),
+        },
+        MaterialDesc::Diffuse {
+            reflectance: Rgb::new(0.2, 0.4, 0.6),
+        },
+        MaterialDesc::Dielectric { eta: 1.5168 },
+        MaterialDesc::Dielectric { eta: 1.33 },
+        // pbrt-v4's default conductor is copper.
+        MaterialDesc::Conductor(ConductorDesc::EtaK {
+            eta: named("metal-Cu-eta"),
+            k: named("metal-Cu-k"),
+        }),
+        MaterialDesc::Conductor(ConductorDesc::EtaK {
+            eta: named("metal-Au-eta"),
+            k: named("metal-Au-k"),
+        }),
+        MaterialDesc::Conductor(ConductorDesc::Reflectance(Rgb::splat(0.9))),
+        MaterialDesc::Diffuse {
+            reflectance: Rgb::splat(0.5),
+        },
+        MaterialDesc::Diffuse {
+            reflectance: Rgb::splat(0.5),
+        },
+        MaterialDesc::Interface,
+    ];
+    assert_eq!(s.materials, expected);
+    // One warning each: BK7 without dispersion, roughness, coateddiffuse, texture.
+    let msgs: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
+    assert_eq!(msgs.len(), 4, "{msgs:#?}");
+    assert!(
+        msgs[1].contains("rendered as smooth") && msgs[2].contains("diffuse with reflectance 0.5")
+    );
+    assert!(err("WorldBegin\nMaterial \"plastic\"\n").contains("unknown material type"));
+}
+
+#[test]
+fn shapes_without_a_material_share_pbrts_default_diffuse() {
+    let s = parse("WorldBegin\nShape \"sphere\"\nShape \"disk\" \"float innerradius\" 0.5\n");
+    assert_eq!(
+        s.materials,
+        vec![MaterialDesc::Diffuse {
+            reflectance: Rgb::splat(0.5)
+        }]
+    );
+    assert_eq!(s.shapes[0].material, s.shapes[1].material);
+    assert_eq!(
+        s.shapes[1].geometry,
+        Geometry::Disk {
+            height: 0.0,
+            radius: 1.0,
+            inner_radius: 0.5,
+            phi_max_deg: 360.0
+        }
+    );
+}
+
+#[test]
+fn attribute_defaults_apply_to_later_shapes() {
+    let s = parse(
+        "WorldBegin\nAttributeBegin\n  Attribute \"shape\" \"float radius\" 3\n  Shape \"sphere\"\n\
+           Shape \"sphere\" \"float radius\" 4\n  Shape \"disk\"\nAttributeEnd\nShape \"sphere\"\n",
+    );
+    let radius = |i: usize| match &s.shapes[i].geometry {
+        Geometry::Sphere { radius, .. } | Geometry::Disk { radius, .. } => *radius,
+        g => panic!("{g:?}"),
+    };
+    assert_eq!(
+        [radius(0), radius(1), radius(2), radius(3)],
+        [3.0, 4.0, 3.0, 1.0]
+    );
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}
+
+#[test]
+fn point_and_spot_lights_follow_the_ctm_and_their_power() {
+    let s = parse(
+        "WorldBegin\nTranslate 0 10 0\n\
+         LightSource \"point\" \"rgb I\" [ 1 2 3 ] \"float scale\" 2 \"point3 from\" [ 1 0 0 ]\n\
+         LightSource \"point\" \"float power\" 100\n\
+         LightSource \"spot\" \"point3 from\" [ 0 0 0 ] \"point3 to\" [ 0 -1 0 ] \"float coneangle\" 40\n\
+           \"float conedeltaangle\" 10 \"float power\" 50 \"blackbody I\" 3000\n",
+    );
+    let LightDesc::Point {
+        position,
+        intensity,
+        ..
+    } = s.lights[0]
+    else {
+        panic!()
+    };
+    assert_eq!(position, Vec3::new(1.0, 10.0, 0.0));
+    assert_eq!(intensity, Rgb::new(2.0, 4.0, 6.0));
+    // Φ = 4π Y(I) for an isotropic point light.
+    let LightDesc::Point { intensity, .. } = s.lights[1] else {
+        panic!()
+    };
+    assert!(close(4.0 * PI * intensity.luminance(), 100.0));
+    let LightDesc::Spot {
+        position,
+        direction,
+        intensity,
+        cos_falloff_start,
+        cos_total_width,
+        ..
+    } = s.lights[2]
+    else {
+        panic!()
+    };
+    assert_eq!(
+        (position, direction),
+        (Vec3::new(0.0, 10.0, 0.0), Vec3::NEG_Y)
+    );
+    assert!(
+        close(cos_total_width, 40f32.to_radians().cos())
+            && close(cos_falloff_start, 30f32.to_radians().cos())
+    );
+    // Φ = 2π I [(1 - cos 30°) + (cos 30° - cos 40°) / 2], and the colour is the
+    // blackbody's.
+    let solid_angle =
+        2.0 * PI * ((1.0 - cos_falloff_start) + 0.5 * (cos_falloff_start - cos_total_width));
+    assert!(close(solid_angle * intensity.luminance(), 50.0));
+    let bb = blackbody_rgb(3000.0).unwrap();
+    assert!(close(intensity.r / intensity.g, bb.r / bb.g));
+}
+
+#[test]
+fn distant_and_infinite_lights() {
+    let s = parse(
+        "WorldBegin\nRotate 90 0 0 1\n\
+         LightSource \"distant\" \"point3 from\" [ 0 0 0 ] \"point3 to\" [ 1 0 0 ] \"rgb L\" [ 2 2 2 ]\n\
+         LightSource \"infinite\" \"rgb L\" [ 0.5 0.5 0.5 ] \"float scale\" 3\n\
+         LightSource \"infinite\" \"float illuminance\" 10\n",
+    );
+    let LightDesc::Distant {
+        direction,
+        radiance,
+        ..
+    } = s.lights[0]
+    else {
+        panic!()
+    };
+    assert!((direction - Vec3::Y).length() < 1e-6);
+    assert_eq!(radiance, Rgb::splat(2.0));
+    let LightDesc::Infinite { radiance, .. } = s.lights[1] else {
+        panic!()
+    };
+    assert_eq!(radiance, Rgb::splat(1.5));
+    // E = π L on an upward-facing surface.
+    let LightDesc::Infinite { radiance, .. } = s.lights[2] else {
+        panic!()
+    };
+    assert!(close(PI * radiance.luminance(), 10.0));
+}
+
+#[test]
+fn area_lights_scale_and_power() {
+    let s = parse(
+        "WorldBegin\nAttributeBegin\n  AreaLightSource \"diffuse\" \"rgb L\" [ 1 2 3 ] \"float scale\" 2 \"bool twosided\" true\n\
+           Shape \"sphere\"\nAttributeEnd\n\
+         AttributeBegin\n  Scale 2 2 2\n  AreaLightSource \"diffuse\" \"blackbody L\" 6500 \"float power\" 10\n\
+           Shape \"bilinearmesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0  1 1 0 ]\nAttributeEnd\nShape \"disk\"\n",
+    );
+    let al = s.shapes[0].area_light.as_ref().unwrap();
+    assert_eq!((al.l, al.two_sided), (Rgb::new(2.0, 4.0, 6.0), true));
+    // The patch is 2 × 2 after the scale: Φ = π A Y(L) = 10 for one side.
+    let al = s.shapes[1].area_light.as_ref().unwrap();
+    assert!(close(PI * 4.0 * al.l.luminance(), 10.0), "{:?}", al.l);
+    assert!(
+        s.shapes[2].area_light.is_none(),
+        "AttributeEnd ends the area light"
+    );
+}
+
+#[test]
+fn unsupported_things_warn_once_each_and_parse_on() {
+    let s = parse(
+        "Sampler \"halton\"\nPixelFilter \"mitchell\" \"float B\" 0.3\nFilm \"gbuffer\"\nAccelerator \"bvh\"\n\
+         Option \"bool disablepixeljitter\" true\nWorldBegin\nTexture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" 4\n\
+         MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\n\
+         Shape \"curve\" \"point3 P\" [ 0 0 0 1 1 1 2 2 2 3 3 3 ]\nLightSource \"goniometric\"\n\
+         Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer faceIndices\" [ 0 ]\n",
+    );
+    let lines: Vec<u32> = s.warnings.iter().map(|w| w.loc.line).collect();
+    assert_eq!(
+        lines,
+        vec![1, 2, 3, 5, 7, 8, 9, 10, 11, 12],
+        "{:#?}",
+        s.warnings
+    );
+    assert_eq!(s.shapes.len(), 1);
+    assert!(s.lights.is_empty());
+}
+
+#[test]
+fn bad_values_are_errors_at_their_location() {
+    for (text, at) in [
+        (
+            "WorldBegin\nShape \"sphere\" \"float radius\" \"big\"\n",
+            "t.pbrt:2:16:",
+        ),
+        (
+            "WorldBegin\nShape \"sphere\" \"float radius\" [ 1 \"x\" ]\n",
+            "t.pbrt:2:35:",
+        ),
+        (
+            "WorldBegin\nShape \"sphere\" \"floot radius\" 1\n",
+            "t.pbrt:2:16:",
+        ),
+        (
+            "WorldBegin\nShape \"sphere\" \"float radius\" 1 \"float radius\" 2\n",
+            "t.pbrt:2:33:",
+        ),
+        ("Scale 1 0 1\n", "t.pbrt:1:1:"),
+        ("LookAt 0 0 0  0 0 0  0 1 0\n", "t.pbrt:1:1:"),
+        ("Translate 1 2\nWorldBegin\n", "t.pbrt:2:1:"),
+        (
+            "WorldBegin\nShape \"bilinearmesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ]\n",
+            "t.pbrt:2:1:",
+        ),
+        ("WorldBegin\nWorldBegin\n", "t.pbrt:2:1:"),
+        (
+            "WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"point2 uv\" [ 0 0 ]\n",
+            "t.pbrt:2:55:",
+        ),
+        ("\"float x\" 1\n", "t.pbrt:1:1:"),
+    ] {
+        let e = err(text);
+        assert!(e.starts_with(at), "{text:?}: expected {at}, got {e}");
+    }
+}

@@ -1,0 +1,9 @@
+//! The test kit: paths to the repository's scenes and the shared reference data,
+//! fixtures built on the canonical scenes, and statistical checks, shared by the tests
+//! and benchmarks of every crate (a dev-dependency; nothing here ships in the binary).
+
+#![forbid(unsafe_code)]
+
+pub mod data;
+
+pub use data::{repo_path, shared, shared_root};
