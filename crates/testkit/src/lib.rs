@@ -4,6 +4,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod chi2;
 pub mod data;
 
 pub use data::{repo_path, shared, shared_root};
