@@ -8,6 +8,7 @@ pub mod exr;
 pub mod falsecolor;
 pub mod film;
 pub mod filter;
+pub mod flip;
 pub mod metrics;
 pub mod pfm;
 pub mod png;
