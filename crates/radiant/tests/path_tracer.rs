@@ -1,14 +1,12 @@
 //! Path tracer physics: the white furnace, pbrt's analytic sphere, and determinism
 //! across thread counts.
 
-use glam::Vec3;
 use radiant::Session;
-use radiant::color::Rgb;
 use radiant::image::Image;
-use radiant::math::Transform;
 use radiant::render::{Overrides, Progress};
+use radiant::scene::SceneDesc;
 use radiant::scene::builtin::{cornell_box, furnace};
-use radiant::scene::{Geometry, LightDesc, MaterialDesc, SceneDesc, ShapeDesc};
+use radiant_testkit::fixtures::{LIT_SPHERE_RADIANCE, lit_sphere};
 
 fn render(desc: &SceneDesc, spp: u32, threads: usize) -> Image {
     let session = Session::new(
@@ -64,28 +62,13 @@ fn white_furnace_is_two_everywhere() {
 /// pi at its centre, radiance is 1 everywhere (direct 0.5, then a geometric series).
 #[test]
 fn analytic_sphere_with_point_light_gives_radiance_one() {
-    let mut desc = furnace();
-    let ShapeDesc { geometry, .. } = &mut desc.shapes[0];
-    *geometry = Geometry::Sphere {
-        radius: 1.0,
-        z_min: -1.0,
-        z_max: 1.0,
-        phi_max_deg: 360.0,
-    };
-    desc.shapes[0].area_light = None;
-    desc.shapes[0].render_from_object = Transform::IDENTITY;
-    desc.materials = vec![MaterialDesc::Diffuse {
-        reflectance: Rgb::splat(0.5),
-    }];
-    desc.lights.push(LightDesc::Point {
-        position: Vec3::ZERO,
-        intensity: Rgb::splat(std::f32::consts::PI),
-        loc: desc.camera.loc.clone(),
-    });
-    let img = render(&desc, 16, 2);
+    let img = render(&lit_sphere(), 16, 2);
     let (mean, sd) = stats(&img, 1);
     let se = sd / (img.pixels.len() as f64).sqrt();
-    assert!((mean - 1.0).abs() < 4.0 * se + 1e-6, "mean {mean}, se {se}");
+    assert!(
+        (mean - LIT_SPHERE_RADIANCE as f64).abs() < 4.0 * se + 1e-6,
+        "mean {mean}, se {se}"
+    );
 }
 
 /// The same scene, seed and sample count give the same image at any thread count.

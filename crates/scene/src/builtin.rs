@@ -77,7 +77,10 @@ fn sphere(center: Vec3, radius: f32, material: MaterialId, scene: &str) -> Shape
     }
 }
 
-fn right_handed_camera(
+/// A pinhole camera at `eye` looking at `target` with world +x on the image's left
+/// (`Scale -1 1 1` then pbrt's `LookAt`), as the canonical scenes use; `vfov_deg` is
+/// the full field of view; `scene` names the built-in scene for locations.
+pub fn right_handed_camera(
     eye: Vec3,
     target: Vec3,
     up: Vec3,

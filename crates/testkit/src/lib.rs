@@ -6,5 +6,6 @@
 
 pub mod chi2;
 pub mod data;
+pub mod fixtures;
 
 pub use data::{repo_path, shared, shared_root};

@@ -8,7 +8,8 @@ use radiant::render::integrator::photon::{PhotonMaps, PhotonSettings};
 use radiant::render::world::World;
 use radiant::scene::builtin::{LIGHT_LE, cornell_caustics};
 use radiant::scene::params::ParamSet;
-use radiant::scene::{IntegratorDesc, LightDesc, SamplerKind, SceneDesc, ShapeDesc};
+use radiant::scene::{LightDesc, SamplerKind, SceneDesc, ShapeDesc};
+use radiant_testkit::fixtures;
 
 use crate::common;
 
@@ -143,21 +144,16 @@ pub fn maps(world: &World, settings: PhotonSettings) -> PhotonMaps {
 /// `desc` with the integrator `name` and `params`, at `res` × `res` pixels (None:
 /// the scene's resolution).
 pub fn with_integrator(
-    mut desc: SceneDesc,
+    desc: SceneDesc,
     name: &str,
     params: ParamSet,
     res: Option<u32>,
 ) -> SceneDesc {
-    desc.integrator = IntegratorDesc {
-        name: name.into(),
-        params,
-        loc: desc.integrator.loc.clone(),
-    };
-    if let Some(res) = res {
-        desc.film.xresolution = res;
-        desc.film.yresolution = res;
+    let desc = fixtures::with_integrator(desc, name, params);
+    match res {
+        Some(res) => fixtures::with_resolution(desc, res, res),
+        None => desc,
     }
-    desc
 }
 
 /// Mean and standard deviation over the pixels of one channel.

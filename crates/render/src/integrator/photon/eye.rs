@@ -227,34 +227,39 @@ fn final_gather(
                 p: y.p,
                 n: facing(y.ng, wo_y_world),
             };
-            let irradiance = maps
-                .irradiance
-                .as_ref()
-                .and_then(|c| c.lookup(&at, maps.max_r2, &mut scratch.nearest))
-                .unwrap_or_else(|| {
-                    // No precomputed point nearby: estimate irradiance here.
-                    let one = |_| Rgb::WHITE;
-                    radiance_estimate(
-                        &maps.global,
-                        &at,
-                        maps.max_r2,
-                        settings.kernel,
-                        0,
-                        &mut scratch.global,
-                        one,
-                    ) + radiance_estimate(
-                        &maps.caustic,
-                        &at,
-                        maps.max_r2,
-                        settings.kernel,
-                        0,
-                        &mut scratch.caustic,
-                        one,
-                    )
-                });
+            let irradiance = gathered_irradiance(maps, &at, scratch);
             sum += beta * (direct + irradiance * mat_y.diffuse_albedo() * INV_PI);
             break;
         }
     }
     sum * (1.0 / n.max(1) as f32)
+}
+
+/// The irradiance a gather ray reads where it lands at `at`: that of the nearest
+/// precomputed point, or, with none near, an estimate from both maps there.
+pub fn gathered_irradiance(maps: &PhotonMaps, at: &EstimatePoint, scratch: &mut EyeScratch) -> Rgb {
+    let settings = &maps.settings;
+    maps.irradiance
+        .as_ref()
+        .and_then(|c| c.lookup(at, maps.max_r2, &mut scratch.nearest))
+        .unwrap_or_else(|| {
+            let one = |_| Rgb::WHITE;
+            radiance_estimate(
+                &maps.global,
+                at,
+                maps.max_r2,
+                settings.kernel,
+                0,
+                &mut scratch.global,
+                one,
+            ) + radiance_estimate(
+                &maps.caustic,
+                at,
+                maps.max_r2,
+                settings.kernel,
+                0,
+                &mut scratch.caustic,
+                one,
+            )
+        })
 }
