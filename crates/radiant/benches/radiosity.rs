@@ -11,11 +11,11 @@
 use std::ops::ControlFlow;
 
 use divan::Bencher;
-use radiant::radiosity::scene::RadiosityScene;
+use radiant::radiosity::mesh::meshed_scene::RadiosityScene;
+use radiant::radiosity::mesh::procedural::cornell_like_box;
 use radiant::radiosity::settings::{FormFactorMethod, RadiositySettings, SolverKind};
-use radiant::radiosity::shapes::cornell_like_box;
 use radiant::radiosity::solve::solve;
-use radiant::radiosity::world_visibility::FaceVisibility;
+use radiant::radiosity::visibility::bvh::FaceVisibility;
 use radiant::radiosity::{
     AlwaysVisible, FormFactorMatrix, HemiCube, IterationSettings, PatchSet, ProgressiveSettings,
     RayCastSettings, RayCaster, ShootingFactors, solve_gauss_seidel, solve_jacobi,

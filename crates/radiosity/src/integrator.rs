@@ -4,10 +4,10 @@
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
-use super::render::{Shading, solve_session};
-use super::scene::RadiosityScene;
-use super::settings::RadiositySettings;
-use super::solve::RadiosityStats;
+use crate::mesh::meshed_scene::RadiosityScene;
+use crate::output::shading::{Shading, solve_session};
+use crate::settings::RadiositySettings;
+use crate::solve::RadiosityStats;
 use radiant_render::RenderContext;
 use radiant_render::integrator::{Integrator, RenderControl, RenderOutput, Stats, render_passes};
 use radiant_scene::{SceneDesc, SceneError, Warning};

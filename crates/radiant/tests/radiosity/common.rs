@@ -3,7 +3,7 @@
 use std::ops::ControlFlow;
 
 use radiant::math::DVec3;
-use radiant::radiosity::scene::RadiosityScene;
+use radiant::radiosity::mesh::meshed_scene::RadiosityScene;
 use radiant::radiosity::settings::RadiositySettings;
 use radiant::radiosity::solve::{Solution, solve};
 use radiant::radiosity::{PatchSet, Visibility};

@@ -1,7 +1,7 @@
 //! Enclosures of enclosures.json solved with form factors computed by radiant.
 
-use radiant::radiosity::report::{closure_error, reciprocity};
-use radiant::radiosity::shapes::{sphere_interior, uniform_z_rings};
+use radiant::radiosity::mesh::procedural::{sphere_interior, uniform_z_rings};
+use radiant::radiosity::solve::diagnostics::{closure_error, reciprocity};
 use radiant::radiosity::{
     AlwaysVisible, FormFactorMatrix, IterationSettings, PatchSet, Quadrature, RayCastSettings,
     RayCaster, solve_gauss_seidel, solve_jacobi,

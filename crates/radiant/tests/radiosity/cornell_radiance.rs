@@ -7,12 +7,12 @@ use std::ops::ControlFlow;
 
 use radiant::color::Rgb;
 use radiant::math::{DVec3, Vec3};
-use radiant::radiosity::adaptive::solve_adaptive;
-use radiant::radiosity::irradiance::{GatherSettings, irradiance_at};
-use radiant::radiosity::scene::RadiosityScene;
+use radiant::radiosity::mesh::meshed_scene::RadiosityScene;
+use radiant::radiosity::output::point_irradiance::{GatherSettings, irradiance_at};
 use radiant::radiosity::settings::{RadiositySettings, SolverKind};
 use radiant::radiosity::solve::Solution;
-use radiant::radiosity::world_visibility::FaceVisibility;
+use radiant::radiosity::solve::adaptive::solve_adaptive;
+use radiant::radiosity::visibility::bvh::FaceVisibility;
 use radiant::render::light::SceneSphere;
 use radiant::scene::builtin::cornell_box;
 use radiant::scene::{AreaLightDesc, FileLoc, MaterialDesc, SceneDesc, ShapeDesc};

@@ -2,7 +2,7 @@
 
 use std::ops::ControlFlow;
 
-use radiant::radiosity::report::{energy_balance, irradiance};
+use radiant::radiosity::solve::diagnostics::{energy_balance, irradiance};
 use radiant::radiosity::{
     AlwaysVisible, FormFactorMatrix, IterationSettings, PatchSet, ProgressiveSettings,
     ShooterSelection, ShootingFactors, solve_gauss_seidel, solve_jacobi, solve_progressive,

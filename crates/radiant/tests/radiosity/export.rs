@@ -3,12 +3,12 @@
 
 use std::path::PathBuf;
 
-use radiant::radiosity::export::{LitMesh, write_gltf, write_patch_csv, write_ply};
-use radiant::radiosity::render::Shading;
-use radiant::radiosity::scene::RadiosityScene;
+use radiant::radiosity::mesh::meshed_scene::RadiosityScene;
+use radiant::radiosity::output::export::{LitMesh, write_gltf, write_patch_csv, write_ply};
+use radiant::radiosity::output::shading::Shading;
 use radiant::radiosity::settings::RadiositySettings;
 use radiant::radiosity::solve::Solution;
-use radiant::radiosity::world_visibility::FaceVisibility;
+use radiant::radiosity::visibility::bvh::FaceVisibility;
 use radiant::render::world::World;
 use radiant::scene::builtin::cornell_box;
 

@@ -2,9 +2,9 @@
 
 use radiant::math::DVec3;
 use radiant::math::hash::Pcg32;
-use radiant::radiosity::formfactor::polygon_to_polygon_factor;
-use radiant::radiosity::patch::equal_area_disk_polygon;
-use radiant::radiosity::quadrature::{PatchRule, Rule1D};
+use radiant::radiosity::formfactor::quadrature::{PatchRule, Rule1D};
+use radiant::radiosity::formfactor::ray_cast::polygon_to_polygon_factor;
+use radiant::radiosity::mesh::patch::equal_area_disk_polygon;
 use radiant::radiosity::{
     AlwaysVisible, BruteForceVisibility, PatchSet, Quadrature, RayCastSettings, RayCaster,
     point_polygon_factor,

@@ -2,7 +2,7 @@
 //! table of hemicube_errors.json.
 
 use radiant::math::DVec3;
-use radiant::radiosity::patch::equal_area_disk_polygon;
+use radiant::radiosity::mesh::patch::equal_area_disk_polygon;
 use radiant::radiosity::{HemiCube, PatchSet, point_polygon_factor};
 use serde_json::Value;
 

@@ -4,8 +4,8 @@
 use std::ops::ControlFlow;
 
 use radiant::math::DVec3;
-use radiant::radiosity::report::{closure, closure_error, energy_balance, reciprocity};
-use radiant::radiosity::shapes::cornell_like_box;
+use radiant::radiosity::mesh::procedural::cornell_like_box;
+use radiant::radiosity::solve::diagnostics::{closure, closure_error, energy_balance, reciprocity};
 use radiant::radiosity::{
     AlwaysVisible, BruteForceVisibility, HemiCube, IterationSettings, PatchSet,
     ProgressiveSettings, Quadrature, RayCastSettings, RayCaster, ShootingFactors,
@@ -314,8 +314,8 @@ fn rows_and_columns_on_the_fly_match_the_matrix() {
 
 #[test]
 fn mismatched_inputs_are_errors_not_panics() {
-    use radiant::radiosity::progressive::ProgressiveError;
-    use radiant::radiosity::solver::SolveError;
+    use radiant::radiosity::solve::matrix_solvers::SolveError;
+    use radiant::radiosity::solve::progressive::ProgressiveError;
     use radiant::radiosity::{FormFactorMatrix, ShooterSelection};
     let set = small_box();
     let wrong = FormFactorMatrix::from_rows(&[vec![0.0]]).unwrap();

@@ -4,10 +4,10 @@
 use std::ops::ControlFlow;
 
 use radiant::math::{DVec3, Vec3};
-use radiant::radiosity::scene::RadiosityScene;
+use radiant::radiosity::mesh::meshed_scene::RadiosityScene;
 use radiant::radiosity::settings::{FormFactorMethod, RadiositySettings, SolverKind};
 use radiant::radiosity::solve::{Solution, solve};
-use radiant::radiosity::world_visibility::{FaceVisibility, WorldVisibility};
+use radiant::radiosity::visibility::bvh::{FaceVisibility, WorldVisibility};
 use radiant::radiosity::{Visibility, settings};
 use radiant::render::world::World;
 use radiant::scene::builtin::cornell_box;

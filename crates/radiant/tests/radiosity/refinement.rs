@@ -6,11 +6,11 @@ use std::ops::ControlFlow;
 
 use radiant::math::DVec3;
 use radiant::math::hash::hash_u64s;
-use radiant::radiosity::adaptive::{contrast_marks, solve_adaptive};
-use radiant::radiosity::refine::Refinement;
-use radiant::radiosity::scene::{NO_TWIN, RadiosityScene};
+use radiant::radiosity::mesh::meshed_scene::{NO_TWIN, RadiosityScene};
+use radiant::radiosity::mesh::refinement::Refinement;
 use radiant::radiosity::settings::RadiositySettings;
-use radiant::radiosity::world_visibility::FaceVisibility;
+use radiant::radiosity::solve::adaptive::{contrast_marks, solve_adaptive};
+use radiant::radiosity::visibility::bvh::FaceVisibility;
 use radiant::render::world::World;
 use radiant::scene::builtin::cornell_box;
 

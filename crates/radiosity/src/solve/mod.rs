@@ -6,6 +6,18 @@
 //! the light's first reflection, which is exact for `B = E + rho (H0 + F B)`. The power
 //! they send is booked separately: what reaches patches is absorbed or reflected there,
 //! the rest of `Light::power` escapes.
+//!
+//! The solvers it chooses from, and what checks them:
+//! - [`matrix_solvers`]: Jacobi and Gauss-Seidel on a stored factor matrix.
+//! - [`progressive`]: progressive refinement (shooting), factors on the fly, O(N)
+//!   memory.
+//! - [`adaptive`]: solve, split neighbours whose radiosities differ, solve again.
+//! - [`diagnostics`]: reciprocity, closure, irradiance and energy balance.
+
+pub mod adaptive;
+pub mod diagnostics;
+pub mod matrix_solvers;
+pub mod progressive;
 
 use std::ops::ControlFlow;
 use std::time::Instant;
@@ -14,21 +26,20 @@ use glam::Vec2;
 use rayon::prelude::*;
 use thiserror::Error;
 
-use super::formfactor::{Quadrature, RayCastSettings, RayCaster};
-use super::hemicube::{HemiCube, HemiCubeError};
-use super::matrix::FormFactorMatrix;
-use super::patch::PatchSet;
-use super::progressive::{
+use self::matrix_solvers::{IterationSettings, SolveError, solve_gauss_seidel, solve_jacobi};
+use self::progressive::{
     ProgressiveError, ProgressiveSettings, ProgressiveState, ShooterSelection, ShootingFactors,
     solve_progressive_from,
 };
-use super::quadrature::{PatchRule, Rule1D};
-use super::report;
-use super::scene::RadiosityScene;
-use super::settings::{FormFactorMethod, RadiositySettings, SolverKind};
-use super::solver::{IterationSettings, SolveError, solve_gauss_seidel, solve_jacobi};
-use super::visibility::Visibility;
-use super::world_visibility::NO_PATCH;
+use crate::formfactor::hemicube::{HemiCube, HemiCubeError};
+use crate::formfactor::matrix::FormFactorMatrix;
+use crate::formfactor::quadrature::{PatchRule, Rule1D};
+use crate::formfactor::ray_cast::{Quadrature, RayCastSettings, RayCaster};
+use crate::mesh::meshed_scene::RadiosityScene;
+use crate::mesh::patch::PatchSet;
+use crate::settings::{FormFactorMethod, RadiositySettings, SolverKind};
+use crate::visibility::Visibility;
+use crate::visibility::bvh::NO_PATCH;
 use radiant_math::hash::Pcg32;
 use radiant_render::light::{Light, SceneSphere};
 
@@ -246,7 +257,7 @@ pub fn solve<V: Visibility>(
 }
 
 /// [`solve`] from a starting guess of every patch's radiosity (progressive refinement
-/// only, see [`super::progressive::solve_progressive_from`]; the matrix solvers start
+/// only, see [`progressive::solve_progressive_from`]; the matrix solvers start
 /// from the emission as always).
 pub fn solve_from<V: Visibility>(
     scene: &RadiosityScene,
@@ -361,9 +372,9 @@ pub fn solve_from<V: Visibility>(
             } else {
                 solve_jacobi(set, &f, iteration, on_sweep)?
             };
-            let balance = report::energy_balance(set, &f, &report.radiosity);
+            let balance = diagnostics::energy_balance(set, &f, &report.radiosity);
             Solution {
-                irradiance: report::irradiance(&f, &report.radiosity),
+                irradiance: diagnostics::irradiance(&f, &report.radiosity),
                 radiosity: report.radiosity,
                 ambient: [0.0; 3],
                 balance: PowerBalance {

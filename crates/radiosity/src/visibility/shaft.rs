@@ -16,7 +16,7 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
-use super::patch::PatchSet;
+use crate::mesh::patch::PatchSet;
 
 /// Receiver tiles are about this many patch edges across.
 const TILE_EDGES: f64 = 6.0;

@@ -15,8 +15,8 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 use super::display::DisplayMesh;
-use super::scene::RadiosityScene;
-use super::solve::Solution;
+use crate::mesh::meshed_scene::RadiosityScene;
+use crate::solve::Solution;
 
 #[derive(Debug, Error)]
 pub enum ExportError {

@@ -21,9 +21,9 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
-use super::contact::ContactFinder;
+use super::contact_grading::ContactFinder;
+use super::meshed_scene::{NO_TWIN, RadiosityScene};
 use super::patch::PatchSet;
-use super::scene::{NO_TWIN, RadiosityScene};
 
 /// No children yet.
 const LEAF: u32 = u32::MAX;
@@ -201,7 +201,7 @@ impl Refinement {
     }
 
     /// Splits, `levels` times over, the leaf cells that lie within `reach` times their
-    /// longest edge of a contact edge (see [`super::contact`]), so that rows of cells
+    /// longest edge of a contact edge (see [`super::contact_grading`]), so that rows of cells
     /// halve towards every contact line. Returns the number of red splits made.
     pub fn grade_contacts(&mut self, levels: u32, reach: f64) -> usize {
         if levels == 0 {

@@ -14,12 +14,12 @@ use std::sync::atomic::Ordering;
 
 use glam::{DVec3, Vec3};
 
-use super::adaptive::{AdaptiveSolution, solve_adaptive};
 use super::display::{DisplayMesh, PatchTracer};
-use super::scene::RadiosityScene;
-use super::settings::{RadiositySettings, VisibilitySource};
-use super::solve::{RadiosityError, SolveEvent};
-use super::world_visibility::{FaceVisibility, SceneVisibility, WorldVisibility};
+use crate::mesh::meshed_scene::RadiosityScene;
+use crate::settings::{RadiositySettings, VisibilitySource};
+use crate::solve::adaptive::{AdaptiveSolution, solve_adaptive};
+use crate::solve::{RadiosityError, SolveEvent};
+use crate::visibility::bvh::{FaceVisibility, SceneVisibility, WorldVisibility};
 use radiant_math::color::Rgb;
 use radiant_math::{Frame, sampling};
 use radiant_render::Progress;

@@ -6,11 +6,11 @@
 
 use glam::DVec3;
 
-use super::contour::point_polygon_factor;
-use super::patch::PatchSet;
-use super::quadrature::PatchRule;
-use super::visibility::Visibility;
-use super::world_visibility::NO_PATCH;
+use crate::formfactor::contour_integral::point_polygon_factor;
+use crate::formfactor::quadrature::PatchRule;
+use crate::mesh::patch::PatchSet;
+use crate::visibility::Visibility;
+use crate::visibility::bvh::NO_PATCH;
 use radiant_math::hash::{Pcg32, hash_u64s};
 
 /// Shadow rays per patch for [`irradiance_at`]: `per_side^2` stratified points per

@@ -17,11 +17,11 @@ use std::ops::ControlFlow;
 use rayon::prelude::*;
 use thiserror::Error;
 
-use super::formfactor::RayCaster;
-use super::hemicube::{HemiCube, HemiCubeBuffers};
-use super::matrix::FormFactorMatrix;
-use super::patch::PatchSet;
-use super::visibility::{InShot, ShotCull, Visibility};
+use crate::formfactor::hemicube::{HemiCube, HemiCubeBuffers};
+use crate::formfactor::matrix::FormFactorMatrix;
+use crate::formfactor::ray_cast::RayCaster;
+use crate::mesh::patch::PatchSet;
+use crate::visibility::{InShot, ShotCull, Visibility};
 
 #[derive(Debug, Error, PartialEq)]
 pub enum ProgressiveError {

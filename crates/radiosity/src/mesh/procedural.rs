@@ -1,6 +1,5 @@
 //! Meshed test scenes built in code: subdivided rectangles with shared corner points,
-//! a Cornell-like box and the inside of a sphere. Used by tests, benchmarks and (until
-//! scene meshing exists) the command line.
+//! a Cornell-like box and the inside of a sphere. Used by tests and benchmarks.
 
 use glam::DVec3;
 

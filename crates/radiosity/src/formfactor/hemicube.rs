@@ -21,9 +21,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 use thiserror::Error;
 
-use super::contour::point_polygon_factor;
+use super::contour_integral::point_polygon_factor;
 use super::matrix::FormFactorMatrix;
-use super::patch::{PatchSet, tangent_frame};
+use crate::mesh::patch::{PatchSet, tangent_frame};
 
 #[derive(Debug, Error, PartialEq)]
 pub enum HemiCubeError {

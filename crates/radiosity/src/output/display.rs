@@ -10,8 +10,8 @@
 
 use glam::DVec3;
 
-use super::patch::PatchSet;
-use super::scene::{NO_TWIN, RadiosityScene};
+use crate::mesh::meshed_scene::{NO_TWIN, RadiosityScene};
+use crate::mesh::patch::PatchSet;
 use radiant_render::accel::TriangleBvh;
 use radiant_render::geometry::Ray;
 
@@ -241,7 +241,7 @@ impl PatchTracer {
 /// interpolation: `(u, v)` with `x = (1-u)(1-v) c0 + u(1-v) c1 + uv c2 + (1-u)v c3`.
 /// Eliminating `v` leaves a quadratic in `u` (solved in the quad's plane).
 pub fn bilinear_weights(c: &[DVec3], normal: DVec3, x: DVec3) -> [f64; 4] {
-    let (s, t) = super::patch::tangent_frame(normal);
+    let (s, t) = crate::mesh::patch::tangent_frame(normal);
     let to2 = |v: DVec3| glam::DVec2::new(v.dot(s), v.dot(t));
     let q = to2(x - c[0]);
     let e1 = to2(c[1] - c[0]);

@@ -1,10 +1,17 @@
 //! Visibility between points on patches, abstract so the renderer's BVH can be plugged
 //! in; a brute-force ray-polygon test serves tests and small scenes.
+//!
+//! - [`bvh`]: shadow rays through the renderer's BVHs, against the render world or the
+//!   unsubdivided faces the patches were cut from.
+//! - [`shaft`]: shaft culling, the few occluders that matter per progressive shot.
+
+pub mod bvh;
+pub mod shaft;
 
 use glam::DVec3;
 
-use super::patch::PatchSet;
-pub use super::shaft::ShotCull;
+pub use self::shaft::ShotCull;
+use crate::mesh::patch::PatchSet;
 
 /// Answers whether the open segment between two points on two patches is unobstructed.
 pub trait Visibility: Sync {

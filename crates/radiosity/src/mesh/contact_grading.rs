@@ -16,7 +16,7 @@ use std::collections::{HashMap, HashSet};
 
 use glam::DVec3;
 
-use super::mesh::FaceMesh;
+use super::face_mesh::FaceMesh;
 
 /// A planar face as a convex polygon with its plane.
 #[derive(Clone, Debug)]

@@ -2,8 +2,8 @@
 //! (`A_i F_ij = A_j F_ji`), closure (`sum_j F_ij = 1` in a closed scene), irradiance and
 //! the energy balance (emitted = absorbed + escaped).
 
-use super::matrix::FormFactorMatrix;
-use super::patch::PatchSet;
+use crate::formfactor::matrix::FormFactorMatrix;
+use crate::mesh::patch::PatchSet;
 
 /// The worst violation of reciprocity.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,7 +70,7 @@ pub fn irradiance<T: Copy + Into<f64>>(
     radiosity: &[[f64; 3]],
 ) -> Vec<[f64; 3]> {
     (0..f.len())
-        .map(|i| super::solver::gather(f.row(i), radiosity))
+        .map(|i| super::matrix_solvers::gather(f.row(i), radiosity))
         .collect()
 }
 

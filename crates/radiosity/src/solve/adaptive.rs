@@ -6,7 +6,7 @@
 //! Solve, compare every pair of patches that share an edge on the same surface (same
 //! material, normals within the display's smoothing angle), split both when their
 //! radiosities differ by more than a fraction `threshold` of the larger in some band,
-//! and solve again on the refined mesh ([`super::refine`] keeps it conforming). Shadow
+//! and solve again on the refined mesh ([`crate::mesh::refinement`] keeps it conforming). Shadow
 //! boundaries, penumbrae and the dark strips along contact edges draw the splits;
 //! evenly lit regions keep their patches. Patches that received no light at all
 //! (hidden under a block) are left alone: the step at their edge is geometry, not a
@@ -15,12 +15,12 @@
 use std::collections::HashMap;
 use std::ops::ControlFlow;
 
-use super::display::SMOOTH_ANGLE_DEG;
-use super::refine::{RefinedScene, Refinement};
-use super::scene::RadiosityScene;
-use super::settings::RadiositySettings;
-use super::solve::{RadiosityError, Solution, SolveEvent, solve_from};
-use super::visibility::Visibility;
+use super::{RadiosityError, Solution, SolveEvent, solve_from};
+use crate::mesh::meshed_scene::RadiosityScene;
+use crate::mesh::refinement::{RefinedScene, Refinement};
+use crate::output::display::SMOOTH_ANGLE_DEG;
+use crate::settings::RadiositySettings;
+use crate::visibility::Visibility;
 use radiant_render::light::{Light, SceneSphere};
 
 /// Radiosities below this fraction of the band's area-weighted mean count as this much

@@ -250,7 +250,7 @@ mod far_field_tests {
                     continue;
                 }
                 let centre = direction * distance;
-                let (s, t) = crate::patch::tangent_frame(normal);
+                let (s, t) = crate::mesh::patch::tangent_frame(normal);
                 let square = [
                     centre - 0.5 * s - 0.5 * t,
                     centre + 0.5 * s - 0.5 * t,

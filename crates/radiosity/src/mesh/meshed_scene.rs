@@ -1,6 +1,6 @@
 //! From a scene description to patches: every diffuse surface (triangle meshes,
 //! bilinear patches, tessellated spheres and disks, instances flattened) as planar faces
-//! in render space, then split by [`super::mesh`] into one shared-vertex patch mesh.
+//! in render space, then split by [`super::face_mesh`] into one shared-vertex patch mesh.
 //!
 //! Per band: exitance `E = pi L` on the emitting side of area lights (Lambertian
 //! emitters), reflectance = the diffuse albedo. Specular materials have no diffuse part
@@ -10,9 +10,9 @@
 
 use glam::{DMat4, DVec3, Vec3};
 
-use super::mesh::{FaceMesh, Subdivision};
+use super::face_mesh::{FaceMesh, Subdivision};
 use super::patch::PatchSet;
-use super::settings::{DEFAULT_PATCH_COUNT, RadiositySettings};
+use crate::settings::{DEFAULT_PATCH_COUNT, RadiositySettings};
 use radiant_scene::{
     Geometry, LightDesc, MaterialDesc, SceneDesc, SceneError, ShapeDesc, Warning, sphere_z_range,
 };

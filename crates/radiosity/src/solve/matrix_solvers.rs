@@ -10,8 +10,8 @@
 use rayon::prelude::*;
 use thiserror::Error;
 
-use super::matrix::FormFactorMatrix;
-use super::patch::PatchSet;
+use crate::formfactor::matrix::FormFactorMatrix;
+use crate::mesh::patch::PatchSet;
 
 #[derive(Debug, Error, PartialEq)]
 pub enum SolveError {

@@ -2,7 +2,7 @@
 //! quadrature points on one patch, times the visible fraction of shadow rays to the other.
 //!
 //! `F_ij = (1/A_i) Integral_{A_i} F(dA_x -> A_j) V(x) dA_x`. The inner factor is exact
-//! (see [`super::contour`]), so with full visibility only the outer integral is
+//! (see [`super::contour_integral`]), so with full visibility only the outer integral is
 //! approximated, and the estimate converges to the exact `F_ij` as the number of points
 //! grows. This is the scheme of Wallace, Elmquist & Haines, "A Ray Tracing Algorithm for
 //! Progressive Radiosity" (SIGGRAPH 1989), with their point-to-disk term replaced by the
@@ -13,11 +13,11 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::contour::{point_disk_approximation, point_polygon_factor};
+use super::contour_integral::{point_disk_approximation, point_polygon_factor};
 use super::matrix::FormFactorMatrix;
-use super::patch::{PatchSet, Polygon};
 use super::quadrature::{PatchRule, Rule1D};
-use super::visibility::Visibility;
+use crate::mesh::patch::{PatchSet, Polygon};
+use crate::visibility::Visibility;
 use radiant_math::hash::{Pcg32, hash_u64s};
 
 /// Where on the integrating patch the point-to-polygon factor is evaluated.

@@ -7,10 +7,10 @@
 
 use glam::{DVec3, Vec3};
 
-use super::patch::PatchSet;
-use super::scene::RadiosityScene;
 use super::shaft::ShaftCuller;
-use super::visibility::{ShotCull, Visibility};
+use super::{ShotCull, Visibility};
+use crate::mesh::meshed_scene::RadiosityScene;
+use crate::mesh::patch::PatchSet;
 use radiant_render::accel::TriangleBvh;
 use radiant_render::geometry::Ray;
 use radiant_render::geometry::ray::offset_origin;
