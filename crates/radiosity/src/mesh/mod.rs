@@ -6,7 +6,8 @@
 //!   into one patch set with the surface, material and back twin of every patch
 //!   ([`meshed_scene::RadiosityScene`]).
 //! - [`face_mesh`]: planar input faces over welded points split into patches with no
-//!   T-junctions (per-edge segment counts, grids, stitching strips).
+//!   T-junctions (per-edge segment counts, grids, stitching strips; the cutting itself
+//!   in the private `tessellation`).
 //! - [`contact_grading`]: finding where one surface touches another it shares no edge
 //!   with, so the patches there can be split a priori.
 //! - [`refinement`]: conforming red-green splits of a meshed scene.
@@ -18,3 +19,4 @@ pub mod meshed_scene;
 pub mod patch;
 pub mod procedural;
 pub mod refinement;
+mod tessellation;
