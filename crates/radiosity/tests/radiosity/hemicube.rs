@@ -1,9 +1,9 @@
 //! Hemi-cube factors against exact point factors (formfactors.json) and the error
 //! table of hemicube_errors.json.
 
-use radiant::math::DVec3;
-use radiant::radiosity::mesh::patch::equal_area_disk_polygon;
-use radiant::radiosity::{HemiCube, PatchSet, point_polygon_factor};
+use radiant_math::DVec3;
+use radiant_radiosity::mesh::patch::equal_area_disk_polygon;
+use radiant_radiosity::{HemiCube, PatchSet, point_polygon_factor};
 use serde_json::Value;
 
 use crate::common::{shared_json, vec3, vertices};

@@ -3,10 +3,10 @@
 
 use std::ops::ControlFlow;
 
-use radiant::math::DVec3;
-use radiant::radiosity::mesh::procedural::cornell_like_box;
-use radiant::radiosity::solve::diagnostics::{closure, closure_error, energy_balance, reciprocity};
-use radiant::radiosity::{
+use radiant_math::DVec3;
+use radiant_radiosity::mesh::procedural::cornell_like_box;
+use radiant_radiosity::solve::diagnostics::{closure, closure_error, energy_balance, reciprocity};
+use radiant_radiosity::{
     AlwaysVisible, BruteForceVisibility, HemiCube, IterationSettings, PatchSet,
     ProgressiveSettings, Quadrature, RayCastSettings, RayCaster, ShootingFactors,
     solve_gauss_seidel, solve_jacobi, solve_progressive,
@@ -314,9 +314,9 @@ fn rows_and_columns_on_the_fly_match_the_matrix() {
 
 #[test]
 fn mismatched_inputs_are_errors_not_panics() {
-    use radiant::radiosity::solve::matrix_solvers::SolveError;
-    use radiant::radiosity::solve::progressive::ProgressiveError;
-    use radiant::radiosity::{FormFactorMatrix, ShooterSelection};
+    use radiant_radiosity::solve::matrix_solvers::SolveError;
+    use radiant_radiosity::solve::progressive::ProgressiveError;
+    use radiant_radiosity::{FormFactorMatrix, ShooterSelection};
     let set = small_box();
     let wrong = FormFactorMatrix::from_rows(&[vec![0.0]]).unwrap();
     assert_eq!(

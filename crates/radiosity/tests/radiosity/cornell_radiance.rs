@@ -5,17 +5,17 @@
 
 use std::ops::ControlFlow;
 
-use radiant::color::Rgb;
-use radiant::math::{DVec3, Vec3};
-use radiant::radiosity::mesh::meshed_scene::RadiosityScene;
-use radiant::radiosity::output::point_irradiance::{GatherSettings, irradiance_at};
-use radiant::radiosity::settings::{RadiositySettings, SolverKind};
-use radiant::radiosity::solve::Solution;
-use radiant::radiosity::solve::adaptive::solve_adaptive;
-use radiant::radiosity::visibility::bvh::FaceVisibility;
-use radiant::render::light::SceneSphere;
-use radiant::scene::builtin::cornell_box;
-use radiant::scene::{AreaLightDesc, FileLoc, MaterialDesc, SceneDesc, ShapeDesc};
+use radiant_math::color::Rgb;
+use radiant_math::{DVec3, Vec3};
+use radiant_radiosity::mesh::meshed_scene::RadiosityScene;
+use radiant_radiosity::output::point_irradiance::{GatherSettings, irradiance_at};
+use radiant_radiosity::settings::{RadiositySettings, SolverKind};
+use radiant_radiosity::solve::Solution;
+use radiant_radiosity::solve::adaptive::solve_adaptive;
+use radiant_radiosity::visibility::bvh::FaceVisibility;
+use radiant_render::light::SceneSphere;
+use radiant_scene::builtin::cornell_box;
+use radiant_scene::{AreaLightDesc, FileLoc, MaterialDesc, SceneDesc, ShapeDesc};
 use rayon::prelude::*;
 use serde_json::Value;
 
@@ -311,9 +311,9 @@ fn irradiance_matches_radiance_on_floor_and_back_wall() {
 #[test]
 #[ignore]
 fn radiance_discrepancy_is_shared_by_the_path_tracer() {
-    use radiant::render::integrator::{PathSettings, path};
-    use radiant::render::sampler::PixelSample;
-    use radiant::render::world::World;
+    use radiant_render::integrator::{PathSettings, path};
+    use radiant_render::sampler::PixelSample;
+    use radiant_render::world::World;
     let solved = solved();
     let data = &solved.data;
     let desc = radiance_cornell(data);
@@ -340,17 +340,17 @@ fn radiance_discrepancy_is_shared_by_the_path_tracer() {
             })
     {
         let x = p + 0.01 * n;
-        let frame = radiant::math::Frame::from_normal(n.as_vec3());
+        let frame = radiant_math::Frame::from_normal(n.as_vec3());
         let count = 3_000_000u32;
         let sum = (0..count)
             .into_par_iter()
             .map(|i| {
-                let mut s = PixelSample::for_stream(radiant::scene::SamplerKind::Sobol, 7, 1, i);
-                let d = frame.to_world(radiant::math::sampling::cosine_hemisphere(s.get_2d()));
+                let mut s = PixelSample::for_stream(radiant_scene::SamplerKind::Sobol, 7, 1, i);
+                let d = frame.to_world(radiant_math::sampling::cosine_hemisphere(s.get_2d()));
                 let (l, _) = path::radiance(
                     &world,
                     &settings,
-                    radiant::render::geometry::Ray::new(x.as_vec3(), d),
+                    radiant_render::geometry::Ray::new(x.as_vec3(), d),
                     &mut s,
                 );
                 [l.r as f64, l.g as f64, l.b as f64]
@@ -395,10 +395,10 @@ fn radiance_discrepancy_is_shared_by_the_path_tracer() {
 #[test]
 #[ignore]
 fn radiance_departs_where_its_light_sampling_is_coarse() {
-    use radiant::math::hash::{Pcg32, hash_u64s};
-    use radiant::render::geometry::Ray;
-    use radiant::render::material::Material;
-    use radiant::render::world::{NO_LIGHT, World};
+    use radiant_math::hash::{Pcg32, hash_u64s};
+    use radiant_render::geometry::Ray;
+    use radiant_render::material::Material;
+    use radiant_render::world::{NO_LIGHT, World};
     let solved = solved();
     let data = &solved.data;
     let desc = radiance_cornell(data);
@@ -458,7 +458,7 @@ fn radiance_departs_where_its_light_sampling_is_coarse() {
                 let mut weight = [1.0f64; 3];
                 let mut acc = [0.0f64; 3];
                 for depth in 0..200 {
-                    let frame = radiant::math::Frame::from_normal(normal.as_vec3());
+                    let frame = radiant_math::Frame::from_normal(normal.as_vec3());
                     // The first direction from a Hammersley set, which takes out most of
                     // the variance; the rest of the walk is random.
                     let u = if depth == 0 {
@@ -469,7 +469,7 @@ fn radiance_departs_where_its_light_sampling_is_coarse() {
                     } else {
                         glam::Vec2::new(rng.uniform_f64() as f32, rng.uniform_f64() as f32)
                     };
-                    let d = frame.to_world(radiant::math::sampling::cosine_hemisphere(u));
+                    let d = frame.to_world(radiant_math::sampling::cosine_hemisphere(u));
                     let ray = Ray::new((o + 1e-3 * normal).as_vec3(), d);
                     let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
                         break;

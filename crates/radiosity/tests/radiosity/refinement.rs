@@ -4,15 +4,15 @@
 
 use std::ops::ControlFlow;
 
-use radiant::math::DVec3;
-use radiant::math::hash::hash_u64s;
-use radiant::radiosity::mesh::meshed_scene::{NO_TWIN, RadiosityScene};
-use radiant::radiosity::mesh::refinement::Refinement;
-use radiant::radiosity::settings::RadiositySettings;
-use radiant::radiosity::solve::adaptive::{contrast_marks, solve_adaptive};
-use radiant::radiosity::visibility::bvh::FaceVisibility;
-use radiant::render::world::World;
-use radiant::scene::builtin::cornell_box;
+use radiant_math::DVec3;
+use radiant_math::hash::hash_u64s;
+use radiant_radiosity::mesh::meshed_scene::{NO_TWIN, RadiosityScene};
+use radiant_radiosity::mesh::refinement::Refinement;
+use radiant_radiosity::settings::RadiositySettings;
+use radiant_radiosity::solve::adaptive::contrast_marks;
+use radiant_radiosity::visibility::bvh::FaceVisibility;
+use radiant_render::world::World;
+use radiant_scene::builtin::cornell_box;
 
 use crate::mesh_checks::{assert_conforming, segment_distance};
 
@@ -180,82 +180,12 @@ fn contrast_marks_follow_the_shadow_edges() {
 }
 
 #[test]
-fn refined_render_runs_through_the_session() {
-    // `"integer refine" [1]` in the scene file's integrator: the session renders the
-    // refined solution and reports its patch count; energy stays balanced.
-    use radiant::Session;
-    use radiant::radiosity::RadiosityIntegrator;
-    use radiant::radiosity::solve::RadiosityStats;
-    use radiant::render::{Overrides, Progress};
-    use radiant::scene::ParamValue;
-    let mut desc = cornell_box();
-    desc.integrator.name = "radiosity".into();
-    desc.integrator.params = radiant::scene::ParamSet::new()
-        .with("maxpatcharea", ParamValue::Float(vec![4000.0]))
-        .with("tolerance", ParamValue::Float(vec![1e-2]))
-        .with("refine", ParamValue::Int(vec![1]))
-        .with("refinethreshold", ParamValue::Float(vec![0.25]))
-        .with("contactgrading", ParamValue::Int(vec![1]));
-    let overrides = Overrides {
-        spp: Some(1),
-        resolution: Some((16, 16)),
-        ..Overrides::default()
-    };
-    let session = Session::new(&desc, &overrides).unwrap();
-    let unrefined = session
-        .integrator_as::<RadiosityIntegrator>()
-        .expect("radiosity")
-        .scene
-        .patches
-        .len();
-    let out = session.render(&Progress::default());
-    let stats = out
-        .stats
-        .get::<RadiosityStats>()
-        .expect("radiosity statistics");
-    assert!(
-        stats.patches > unrefined,
-        "{} vs {unrefined}",
-        stats.patches
-    );
-    assert!(stats.converged);
-    let imbalance = stats.balance.imbalance();
-    assert!(
-        (0..3).all(|b| imbalance[b].abs() < 1e-9 * stats.balance.emitted[b]),
-        "{imbalance:?}"
-    );
-    assert!(out.film.image().pixels.iter().all(|p| p.is_finite()));
-    // The same through the adaptive solver directly: nothing to refine past the limit.
-    let settings = RadiositySettings {
-        max_patch_area: Some(4000.0),
-        tolerance: 1e-2,
-        refine: 0,
-        ..RadiositySettings::default()
-    };
-    let scene = &session
-        .integrator_as::<RadiosityIntegrator>()
-        .expect("radiosity")
-        .scene;
-    let (world, _) = World::build(&desc).unwrap();
-    let solved = solve_adaptive(
-        scene,
-        &world.lights,
-        world.scene_sphere(),
-        &settings,
-        FaceVisibility::new,
-        |_| ControlFlow::Continue(()),
-    )
-    .unwrap();
-    assert!(solved.scene.is_none() && solved.passes == 0);
-}
-
-#[test]
 fn a_primed_solve_reaches_the_cold_solution() {
     // Progressive refinement from a starting guess (what a refinement pass carries
     // over from the coarser mesh) converges to the same radiosities as a cold start,
     // from a guess that is too bright (negative unshot radiosity) as from one too
     // dark, and keeps every watt booked.
-    use radiant::radiosity::solve::solve_from;
+    use radiant_radiosity::solve::solve_from;
     let scene = cornell(4000.0, false);
     let vis = FaceVisibility::new(&scene);
     let (world, _) = World::build(&cornell_box()).unwrap();

@@ -3,14 +3,14 @@
 
 use std::path::PathBuf;
 
-use radiant::radiosity::mesh::meshed_scene::RadiosityScene;
-use radiant::radiosity::output::export::{LitMesh, write_gltf, write_patch_csv, write_ply};
-use radiant::radiosity::output::shading::Shading;
-use radiant::radiosity::settings::RadiositySettings;
-use radiant::radiosity::solve::Solution;
-use radiant::radiosity::visibility::bvh::FaceVisibility;
-use radiant::render::world::World;
-use radiant::scene::builtin::cornell_box;
+use radiant_radiosity::mesh::meshed_scene::RadiosityScene;
+use radiant_radiosity::output::export::{LitMesh, write_gltf, write_patch_csv, write_ply};
+use radiant_radiosity::output::shading::Shading;
+use radiant_radiosity::settings::RadiositySettings;
+use radiant_radiosity::solve::Solution;
+use radiant_radiosity::visibility::bvh::FaceVisibility;
+use radiant_render::world::World;
+use radiant_scene::builtin::cornell_box;
 
 use crate::common::solve_to_end;
 

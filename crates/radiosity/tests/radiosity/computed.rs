@@ -1,8 +1,8 @@
 //! Enclosures of enclosures.json solved with form factors computed by radiant.
 
-use radiant::radiosity::mesh::procedural::{sphere_interior, uniform_z_rings};
-use radiant::radiosity::solve::diagnostics::{closure_error, reciprocity};
-use radiant::radiosity::{
+use radiant_radiosity::mesh::procedural::{sphere_interior, uniform_z_rings};
+use radiant_radiosity::solve::diagnostics::{closure_error, reciprocity};
+use radiant_radiosity::{
     AlwaysVisible, FormFactorMatrix, IterationSettings, PatchSet, Quadrature, RayCastSettings,
     RayCaster, solve_gauss_seidel, solve_jacobi,
 };

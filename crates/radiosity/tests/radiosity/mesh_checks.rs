@@ -2,9 +2,9 @@
 
 use std::collections::HashMap;
 
-use radiant::math::DVec3;
-use radiant::radiosity::mesh::meshed_scene::RadiosityScene;
-use radiant::radiosity::output::display::DisplayMesh;
+use radiant_math::DVec3;
+use radiant_radiosity::mesh::meshed_scene::RadiosityScene;
+use radiant_radiosity::output::display::DisplayMesh;
 
 /// Distance from `p` to the segment `a b`.
 pub fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {

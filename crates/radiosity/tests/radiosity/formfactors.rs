@@ -1,11 +1,11 @@
 //! Ray-cast (contour) form factors against the exact values of formfactors.json.
 
-use radiant::math::DVec3;
-use radiant::math::hash::Pcg32;
-use radiant::radiosity::formfactor::quadrature::{PatchRule, Rule1D};
-use radiant::radiosity::formfactor::ray_cast::polygon_to_polygon_factor;
-use radiant::radiosity::mesh::patch::equal_area_disk_polygon;
-use radiant::radiosity::{
+use radiant_math::DVec3;
+use radiant_math::hash::Pcg32;
+use radiant_radiosity::formfactor::quadrature::{PatchRule, Rule1D};
+use radiant_radiosity::formfactor::ray_cast::polygon_to_polygon_factor;
+use radiant_radiosity::mesh::patch::equal_area_disk_polygon;
+use radiant_radiosity::{
     AlwaysVisible, BruteForceVisibility, PatchSet, Quadrature, RayCastSettings, RayCaster,
     point_polygon_factor,
 };

@@ -3,15 +3,15 @@
 
 use std::ops::ControlFlow;
 
-use radiant::math::{DVec3, Vec3};
-use radiant::radiosity::mesh::meshed_scene::RadiosityScene;
-use radiant::radiosity::settings::{FormFactorMethod, RadiositySettings, SolverKind};
-use radiant::radiosity::solve::{Solution, solve};
-use radiant::radiosity::visibility::bvh::{FaceVisibility, WorldVisibility};
-use radiant::radiosity::{Visibility, settings};
-use radiant::render::world::World;
-use radiant::scene::builtin::cornell_box;
-use radiant::scene::{FileLoc, Geometry, LightDesc, MaterialDesc, SceneDesc, ShapeDesc};
+use radiant_math::{DVec3, Vec3};
+use radiant_radiosity::Visibility;
+use radiant_radiosity::mesh::meshed_scene::RadiosityScene;
+use radiant_radiosity::settings::{FormFactorMethod, RadiositySettings, SolverKind};
+use radiant_radiosity::solve::{Solution, solve};
+use radiant_radiosity::visibility::bvh::{FaceVisibility, WorldVisibility};
+use radiant_render::world::World;
+use radiant_scene::builtin::cornell_box;
+use radiant_scene::{FileLoc, Geometry, LightDesc, MaterialDesc, SceneDesc, ShapeDesc};
 
 use crate::common::{max_relative_difference, solve_to_end};
 use crate::mesh_checks::assert_conforming;
@@ -163,7 +163,7 @@ fn factor_methods_and_solvers_agree_on_the_cornell_box() {
 fn floor_under_point_light(a: f32, h: f32, i: f32) -> SceneDesc {
     let mut desc = cornell_box();
     desc.materials = vec![MaterialDesc::Diffuse {
-        reflectance: radiant::color::Rgb::splat(0.5),
+        reflectance: radiant_math::color::Rgb::splat(0.5),
     }];
     desc.shapes = vec![ShapeDesc::quads(
         &[[
@@ -177,7 +177,7 @@ fn floor_under_point_light(a: f32, h: f32, i: f32) -> SceneDesc {
     )];
     desc.lights = vec![LightDesc::Point {
         position: Vec3::new(0.0, h, 0.0),
-        intensity: radiant::color::Rgb::splat(i),
+        intensity: radiant_math::color::Rgb::splat(i),
         loc: FileLoc::builtin("test"),
     }];
     desc
@@ -258,111 +258,14 @@ fn a_stopped_solve_reports_where_it_stopped() {
 }
 
 #[test]
-fn integrator_parameters_configure_the_session() {
-    use radiant::Session;
-    use radiant::radiosity::RadiosityIntegrator;
-    use radiant::render::Overrides;
-    use radiant::scene::ParamValue;
-    let mut desc = cornell_box();
-    desc.integrator.name = "radiosity".into();
-    desc.integrator.params = radiant::scene::ParamSet::new()
-        .with("maxpatcharea", ParamValue::Float(vec![5000.0]))
-        .with("solver", ParamValue::String(vec!["jacobi".into()]))
-        .with("finalgather", ParamValue::Int(vec![2]))
-        .with("tolerance", ParamValue::Float(vec![1e-4]))
-        .with("colour", ParamValue::String(vec!["blue".into()]));
-    let overrides = Overrides {
-        spp: Some(1),
-        resolution: Some((16, 16)),
-        ..Overrides::default()
-    };
-    let session = Session::new(&desc, &overrides).unwrap();
-    let radiosity = session
-        .integrator_as::<RadiosityIntegrator>()
-        .expect("radiosity");
-    let s = &radiosity.settings;
-    assert_eq!(s.solver, SolverKind::Jacobi);
-    assert_eq!(s.final_gather, 2);
-    assert!(
-        session
-            .warnings
-            .iter()
-            .any(|w| w.message.contains("colour"))
-    );
-    let scene = &session
-        .integrator_as::<RadiosityIntegrator>()
-        .expect("radiosity")
-        .scene;
-    let largest = scene
-        .patches
-        .patches
-        .iter()
-        .map(|p| p.area)
-        .fold(0.0, f64::max);
-    assert!(largest <= 5000.0 * (1.0 + 1e-9));
-    let out = session.render(&Default::default());
-    assert!(!out.interrupted);
-    let image = out.film.image();
-    assert!(image.pixels.iter().all(|p| p.is_finite()));
-    assert!(image.mean() > 0.05);
-    assert_eq!(settings::DEFAULT_PATCH_COUNT, 2000.0);
-}
-
-#[test]
-fn radiosity_image_matches_the_path_traced_reference() {
-    // The canonical box at 64 x 64 (4 x 4 blocks of the 256 x 256 reference averaged:
-    // the box filter at the coarser pixel), 2,918 patches, final gather of 16 rays, 16
-    // samples per pixel. Measured: mean 0.07 % below the reference, relMSE 1.7e-3,
-    // most of it the pixels on the light's edges (16 samples of a 35:1 step); allowed
-    // 1 % and 4e-3.
-    use radiant::Session;
-    use radiant::image::{Image, compare, read_image};
-    use radiant::render::Overrides;
-    use radiant::scene::ParamValue;
-    let reference_path = radiant_testkit::shared_root().join("refs/cornell-box-256-ref.exr");
-    let full = read_image(&reference_path).unwrap();
-    let mut reference = Image::new(64, 64);
-    for y in 0..64 {
-        for x in 0..64 {
-            let mut sum = radiant::color::Rgb::BLACK;
-            for dy in 0..4 {
-                for dx in 0..4 {
-                    sum += full.get(4 * x + dx, 4 * y + dy);
-                }
-            }
-            reference.set(x, y, sum * (1.0 / 16.0));
-        }
-    }
-    let mut desc = cornell_box();
-    desc.integrator.name = "radiosity".into();
-    desc.integrator.params = radiant::scene::ParamSet::new()
-        .with("maxpatcharea", ParamValue::Float(vec![800.0]))
-        .with("finalgather", ParamValue::Int(vec![16]));
-    let overrides = Overrides {
-        spp: Some(16),
-        resolution: Some((64, 64)),
-        ..Overrides::default()
-    };
-    let session = Session::new(&desc, &overrides).unwrap();
-    let image = session.render(&Default::default()).film.image();
-    let m = compare(&image, &reference, None).unwrap();
-    eprintln!(
-        "mean {} vs {}, relMSE {}",
-        m.mean_test, m.mean_ref, m.relmse
-    );
-    assert!((m.mean_test / m.mean_ref - 1.0).abs() < 0.01);
-    assert!(m.relmse < 4e-3);
-}
-
-#[test]
 fn curved_bilinear_patches_are_meshed_on_their_surface() {
     // The twisted patch y = 0.5 u v over the unit square (x = u, z = v), facing up,
     // under a square area light. Every patch corner lies on the bilinear surface, the
     // patches' area approaches the surface's (1.0790; flat triangles over cells of 1/8
     // of the side under-estimate it by ~1e-4, allowed 1e-3), and every patch sees
     // the light: shadow rays leave the curved surface without hitting it.
-    use radiant::scene::AreaLightDesc;
-    use radiant::scene::mesh::bilinear_patch_area;
+    use radiant_scene::AreaLightDesc;
+    use radiant_scene::mesh::bilinear_patch_area;
     let mut desc = cornell_box();
     let corners = [
         Vec3::new(0.0, 0.0, 0.0),
@@ -379,7 +282,7 @@ fn curved_bilinear_patches_are_meshed_on_their_surface() {
         loc: FileLoc::builtin("test"),
     };
     desc.materials = vec![MaterialDesc::Diffuse {
-        reflectance: radiant::color::Rgb::splat(0.5),
+        reflectance: radiant_math::color::Rgb::splat(0.5),
     }];
     desc.shapes = vec![
         shape(
@@ -396,7 +299,7 @@ fn curved_bilinear_patches_are_meshed_on_their_surface() {
         ),
         ShapeDesc {
             area_light: Some(AreaLightDesc {
-                l: radiant::color::Rgb::splat(1.0),
+                l: radiant_math::color::Rgb::splat(1.0),
                 two_sided: false,
             }),
             ..ShapeDesc::quads(

@@ -2,8 +2,8 @@
 
 use std::ops::ControlFlow;
 
-use radiant::radiosity::solve::diagnostics::{energy_balance, irradiance};
-use radiant::radiosity::{
+use radiant_radiosity::solve::diagnostics::{energy_balance, irradiance};
+use radiant_radiosity::{
     AlwaysVisible, FormFactorMatrix, IterationSettings, PatchSet, ProgressiveSettings,
     ShooterSelection, ShootingFactors, solve_gauss_seidel, solve_jacobi, solve_progressive,
 };

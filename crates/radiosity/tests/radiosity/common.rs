@@ -2,17 +2,17 @@
 
 use std::ops::ControlFlow;
 
-use radiant::math::DVec3;
-use radiant::radiosity::mesh::meshed_scene::RadiosityScene;
-use radiant::radiosity::settings::RadiositySettings;
-use radiant::radiosity::solve::{Solution, solve};
-use radiant::radiosity::{PatchSet, Visibility};
-use radiant::render::world::World;
+use radiant_math::DVec3;
+use radiant_radiosity::mesh::meshed_scene::RadiosityScene;
+use radiant_radiosity::settings::RadiositySettings;
+use radiant_radiosity::solve::{Solution, solve};
+use radiant_radiosity::{PatchSet, Visibility};
+use radiant_render::world::World;
 use serde_json::Value;
 
-/// Parses `../shared/data/<name>`.
+/// Parses `data/<name>` of the shared data.
 pub fn shared_json(name: &str) -> Value {
-    let path = radiant_testkit::shared_root().join("data").join(name);
+    let path = radiant_testkit::shared(&format!("data/{name}"));
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
