@@ -5,24 +5,25 @@
 //! The Cornell-box benchmarks run the whole integrator path on the canonical scene
 //! with its blocks (meshing excluded): shadow rays through the face BVH.
 //!
-//! Run: `cargo bench --bench radiosity` (`RAYON_NUM_THREADS=2` to match the target
-//! machine); one case: `cargo bench --bench radiosity -- cornell_progressive`.
+//! Run: `cargo bench -p radiant-radiosity --bench radiosity` (`RAYON_NUM_THREADS=2` to
+//! match the target machine); one case: `cargo bench -p radiant-radiosity --bench
+//! radiosity -- cornell_progressive`.
 
 use std::ops::ControlFlow;
 
 use divan::Bencher;
-use radiant::radiosity::mesh::meshed_scene::RadiosityScene;
-use radiant::radiosity::mesh::procedural::cornell_like_box;
-use radiant::radiosity::settings::{FormFactorMethod, RadiositySettings, SolverKind};
-use radiant::radiosity::solve::solve;
-use radiant::radiosity::visibility::bvh::FaceVisibility;
-use radiant::radiosity::{
+use radiant_radiosity::mesh::meshed_scene::RadiosityScene;
+use radiant_radiosity::mesh::procedural::cornell_like_box;
+use radiant_radiosity::settings::{FormFactorMethod, RadiositySettings, SolverKind};
+use radiant_radiosity::solve::solve;
+use radiant_radiosity::visibility::bvh::FaceVisibility;
+use radiant_radiosity::{
     AlwaysVisible, FormFactorMatrix, HemiCube, IterationSettings, PatchSet, ProgressiveSettings,
     RayCastSettings, RayCaster, ShootingFactors, solve_gauss_seidel, solve_jacobi,
     solve_progressive,
 };
-use radiant::render::world::World;
-use radiant::scene::builtin::cornell_box;
+use radiant_render::world::World;
+use radiant_scene::builtin::cornell_box;
 
 fn main() {
     divan::main();
