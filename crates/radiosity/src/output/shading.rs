@@ -41,9 +41,10 @@ pub struct Shading<'a> {
 
 impl<'a> Shading<'a> {
     /// Prepares the display of per-patch radiosities `display` (usually
-    /// [`Solution::display_radiosity`]); `irradiance` marks the patches that received
-    /// light, the only ones averaged into a vertex where a lit one is present (patches
-    /// hidden inside solids, such as the floor under a block, would darken its edges).
+    /// [`crate::solve::Solution::display_radiosity`]); `irradiance` marks the patches
+    /// that received light, the only ones averaged into a vertex where a lit one is
+    /// present (patches hidden inside solids, such as the floor under a block, would
+    /// darken its edges).
     pub fn new(
         scene: &'a RadiosityScene,
         world: &'a World,

@@ -84,7 +84,7 @@ pub struct ShaftCuller {
 impl ShaftCuller {
     /// `occluders`: the triangles that can block rays; `patch_face`: the input face of
     /// every patch of `set`; `patch_size`: the patches' edge length (tiles are
-    /// [`TILE_EDGES`] of them across).
+    /// `TILE_EDGES` of them across).
     pub fn new(
         set: &PatchSet,
         patch_face: &[u32],
