@@ -1,15 +1,20 @@
 //! Radiosity as an integrator: mesh the scene when it is chosen, solve when asked to
-//! render, then show the solution through the shared pass loop.
+//! render (refining as the settings ask, with progress and cancellation through the
+//! session's [`Progress`]), then show the solution through the shared pass loop.
 
+use std::ops::ControlFlow;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
-use super::render::{Shading, solve_session};
-use super::scene::RadiosityScene;
-use super::settings::RadiositySettings;
-use super::solve::RadiosityStats;
-use radiant_render::RenderContext;
+use crate::mesh::meshed_scene::RadiosityScene;
+use crate::output::shading::Shading;
+use crate::settings::{RadiositySettings, VisibilitySource};
+use crate::solve::adaptive::{AdaptiveSolution, solve_adaptive};
+use crate::solve::{RadiosityError, RadiosityStats, SolveEvent};
+use crate::visibility::bvh::{FaceVisibility, SceneVisibility, WorldVisibility};
 use radiant_render::integrator::{Integrator, RenderControl, RenderOutput, Stats, render_passes};
+use radiant_render::world::World;
+use radiant_render::{Progress, RenderContext};
 use radiant_scene::{SceneDesc, SceneError, Warning};
 
 /// `Integrator "radiosity"`: the meshed scene and the solver's settings.
@@ -65,4 +70,68 @@ impl Integrator for RadiosityIntegrator {
         });
         out
     }
+}
+
+/// Shadow-ray visibility for the solve, as chosen by the settings.
+pub fn scene_visibility<'a>(
+    scene: &RadiosityScene,
+    world: &'a World,
+    settings: &RadiositySettings,
+) -> SceneVisibility<'a> {
+    match settings.visibility {
+        VisibilitySource::Patches => SceneVisibility::Faces(Box::new(FaceVisibility::new(scene))),
+        VisibilitySource::World => {
+            SceneVisibility::World(WorldVisibility::new(world, &scene.patches))
+        }
+    }
+}
+
+/// Solves the session's radiosity scene (refining it as the settings ask), reporting
+/// progress in thousandths of the way to convergence on `progress` and stopping on its
+/// cancel flag.
+pub fn solve_session(
+    world: &World,
+    scene: &RadiosityScene,
+    settings: &RadiositySettings,
+    progress: &Progress,
+) -> AdaptiveSolution {
+    solve_session_observed(world, scene, settings, progress, |_| {})
+        // Settings were validated when the session was built (hemi-cube resolution) and
+        // the patch set and its solver inputs come from one scene, so no error can remain.
+        .expect("radiosity inputs are consistent")
+}
+
+/// [`solve_session`], showing every solver event to `observe` as well (the CLI writes
+/// the progressive sequence from it).
+pub fn solve_session_observed(
+    world: &World,
+    scene: &RadiosityScene,
+    settings: &RadiositySettings,
+    progress: &Progress,
+    mut observe: impl FnMut(&SolveEvent<'_>),
+) -> Result<AdaptiveSolution, RadiosityError> {
+    progress.total.store(1000, Ordering::Relaxed);
+    progress.done.store(0, Ordering::Relaxed);
+    let sphere = world.scene_sphere();
+    solve_adaptive(
+        scene,
+        &world.lights,
+        sphere,
+        settings,
+        |mesh| scene_visibility(mesh, world, settings),
+        |event| {
+            let done = match event {
+                SolveEvent::Shot { fraction_done, .. } => (1000.0 * fraction_done) as u64,
+                SolveEvent::Factors { done, total } => (900 * done / total.max(1)) as u64,
+                SolveEvent::Sweep { .. } => 900,
+            };
+            progress.done.store(done, Ordering::Relaxed);
+            observe(&event);
+            if progress.cancelled() {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        },
+    )
 }

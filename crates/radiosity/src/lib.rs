@@ -1,57 +1,43 @@
 //! Radiosity: the diffuse global-illumination balance `B_i = E_i + rho_i sum_j F_ij B_j`
-//! over planar patches, solved per colour band (all three at once).
+//! over planar patches, solved per colour band (all three at once), and shown through
+//! the renderer's film as one more [`radiant_render::integrator::Integrator`].
 //!
-//! - [`patch`]: patches over shared corner points, with per-band emission and reflectance.
-//! - [`contour`]: the exact point-to-polygon form factor (Lambert's contour integral).
-//! - [`quadrature`]: Gauss (optionally graded) and stratified points on patches.
-//! - [`formfactor`]: ray-cast patch-to-patch factors (contour at quadrature points
-//!   times shadow-ray visibility), as a full matrix or a row/column on the fly.
-//! - [`hemicube`]: Cohen & Greenberg's hemi-cube with a depth/item buffer.
-//! - [`visibility`]: the pluggable occlusion query (the renderer's BVH goes here).
-//! - [`solver`]: Jacobi and Gauss-Seidel on a stored matrix.
-//! - [`progressive`]: progressive refinement (shooting) with no N^2 storage.
-//! - [`contact`], [`refine`], [`adaptive`]: grading towards contact lines, conforming
-//!   red-green splits, and the solve-split-solve loop driven by neighbour contrast.
-//! - [`report`]: reciprocity, closure, irradiance and energy balance.
-//! - [`shapes`]: meshed boxes and spheres for tests and benchmarks.
+//! Its parts, in the order data flows through them:
+//! - [`mesh`]: patches ([`PatchSet`]) and the meshing of a scene's diffuse surfaces
+//!   into them ([`mesh::meshed_scene::RadiosityScene`]), a-priori grading towards
+//!   contact lines, conforming red-green refinement, and meshed test shapes.
+//! - [`formfactor`]: the exact point-to-polygon factor (contour integral), quadrature
+//!   on patches, ray-cast patch-to-patch factors, the hemi-cube, and the factor matrix.
+//! - [`visibility`]: the occlusion query the factors use ([`Visibility`]), answered by
+//!   the renderer's BVHs or by brute force, with shaft culling per progressive shot.
+//! - [`solve`]: a meshed scene's solve (delta lights as the first shot, factors, the
+//!   chosen solver, the power balance), with Jacobi and Gauss-Seidel, progressive
+//!   refinement, the adaptive solve-split-solve loop, and diagnostics.
+//! - [`output`]: the image (Gouraud display or final gather), glTF/PLY/CSV exports, and
+//!   irradiance at points.
+//! - [`settings`]: the parameters of `Integrator "radiosity"`; [`integrator`]: the
+//!   integrator that meshes when chosen, solves when asked to render, then shows the
+//!   solution through the shared pass loop.
 
 #![forbid(unsafe_code)]
 
-pub mod adaptive;
-pub mod contact;
-pub mod contour;
-pub mod display;
-pub mod export;
 pub mod formfactor;
-pub mod hemicube;
 pub mod integrator;
-pub mod irradiance;
-pub mod matrix;
 pub mod mesh;
-pub mod patch;
-pub mod progressive;
-pub mod quadrature;
-pub mod refine;
-pub mod render;
-pub mod report;
-pub mod scene;
+pub mod output;
 pub mod settings;
-pub mod shaft;
-pub mod shapes;
 pub mod solve;
-pub mod solver;
 pub mod visibility;
-pub mod world_visibility;
 
-pub use contour::point_polygon_factor;
-pub use formfactor::{Quadrature, RayCastSettings, RayCaster};
-pub use hemicube::HemiCube;
+pub use formfactor::contour_integral::point_polygon_factor;
+pub use formfactor::hemicube::HemiCube;
+pub use formfactor::matrix::FormFactorMatrix;
+pub use formfactor::ray_cast::{Quadrature, RayCastSettings, RayCaster};
 pub use integrator::RadiosityIntegrator;
-pub use matrix::FormFactorMatrix;
-pub use patch::{Patch, PatchSet, Polygon};
-pub use progressive::{
+pub use mesh::patch::{Patch, PatchSet, Polygon};
+pub use solve::matrix_solvers::{IterationSettings, SolveReport, solve_gauss_seidel, solve_jacobi};
+pub use solve::progressive::{
     ProgressiveReport, ProgressiveSettings, ProgressiveState, ShooterSelection, ShootingFactors,
     solve_progressive,
 };
-pub use solver::{IterationSettings, SolveReport, solve_gauss_seidel, solve_jacobi};
 pub use visibility::{AlwaysVisible, BruteForceVisibility, Visibility};

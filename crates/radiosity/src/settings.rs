@@ -77,13 +77,13 @@ pub struct RadiositySettings {
     pub max_depth: u32,
     /// Adaptive refinement passes: solve, split the patches whose radiosity differs
     /// from a neighbour's by more than `refine_threshold`, solve again (see
-    /// [`super::adaptive`]). 0 solves the first mesh only.
+    /// [`crate::solve::adaptive`]). 0 solves the first mesh only.
     pub refine: u32,
     /// Relative radiosity contrast between neighbouring patches of one surface above
     /// which both are split.
     pub refine_threshold: f64,
     /// Levels of a-priori grading towards contact edges (a block on the floor): the
-    /// elements touching one are split this many times over (see [`super::contact`]).
+    /// elements touching one are split this many times over (see [`crate::mesh::contact_grading`]).
     pub contact_grading: u32,
 }
 
