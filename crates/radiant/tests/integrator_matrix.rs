@@ -30,7 +30,7 @@ use radiant::image::Image;
 use radiant::math::hash::Pcg32;
 use radiant::math::sampling;
 use radiant::radiosity::RadiosityIntegrator;
-use radiant::radiosity::render::solve_session;
+use radiant::radiosity::integrator::solve_session;
 use radiant::render::integrator::photon::PhotonMaps;
 use radiant::render::integrator::photon::estimate::EstimatePoint;
 use radiant::render::integrator::photon::eye::{EyeScratch, gathered_irradiance};
