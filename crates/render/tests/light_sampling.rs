@@ -860,16 +860,9 @@ fn mis_weighted_direct_light_has_the_mean_of_each_strategy() {
         .intersect(&down_ray, f32::INFINITY)
         .expect("the floor");
     assert_eq!(hit.light, NO_LIGHT);
-    let material = world.materials[hit.material as usize];
-    let frame = Frame::from_normal(hit.ns);
-    let wo_world = Vec3::Z;
-    let at = ShadingPoint {
-        hit: &hit,
-        material: &material,
-        frame: &frame,
-        wo: frame.to_local(wo_world),
-        wo_world,
-    };
+    let (material, wo_world) = (world.materials[hit.material as usize], Vec3::Z);
+    let at = ShadingPoint::new(&hit, material, wo_world);
+    let frame = at.frame;
     let ctx = hit.light_sample_context();
 
     let n = 200_000;

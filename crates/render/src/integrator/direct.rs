@@ -16,13 +16,27 @@ use radiant_math::color::Rgb;
 #[derive(Clone, Copy, Debug)]
 pub struct ShadingPoint<'a> {
     pub hit: &'a SurfaceHit,
-    pub material: &'a Material,
+    pub material: Material,
     /// The shading frame (about `hit.ns`).
-    pub frame: &'a Frame,
+    pub frame: Frame,
     /// Unit direction towards the viewer, in `frame`.
     pub wo: Vec3,
     /// The same direction in render space.
     pub wo_world: Vec3,
+}
+
+impl<'a> ShadingPoint<'a> {
+    /// `hit` with `material`, seen along the unit direction `wo_world`.
+    pub fn new(hit: &'a SurfaceHit, material: Material, wo_world: Vec3) -> ShadingPoint<'a> {
+        let frame = Frame::from_normal(hit.ns);
+        ShadingPoint {
+            hit,
+            material,
+            frame,
+            wo: frame.to_local(wo_world),
+            wo_world,
+        }
+    }
 }
 
 /// One unoccluded light sample seen from a surface point.

@@ -155,13 +155,7 @@ pub fn radiance(
         let u_choice = sampler.get_1d();
         let u_light = sampler.get_2d();
         if !material.is_specular() {
-            let at = direct::ShadingPoint {
-                hit: &hit,
-                material: &material,
-                frame: &frame,
-                wo,
-                wo_world,
-            };
+            let at = direct::ShadingPoint::new(&hit, material, wo_world);
             let ds = direct::sample_direct(world, scene, &at, u_choice, u_light);
             rays += ds.shadow_rays;
             if let Some(ds) = ds.light {

@@ -121,13 +121,7 @@ pub fn radiance(
                 l += beta * emitted;
                 let u_choice = sampler.get_1d();
                 let u_light = sampler.get_2d();
-                let at = ShadingPoint {
-                    hit: &hit,
-                    material: &material,
-                    frame: &frame,
-                    wo,
-                    wo_world,
-                };
+                let at = ShadingPoint::new(&hit, material, wo_world);
                 let direct = sample_direct(world, ctx.scene, &at, u_choice, u_light);
                 rays += direct.shadow_rays;
                 let caustic = estimate(&maps.caustic, 0, &mut scratch.caustic);
@@ -219,13 +213,7 @@ fn final_gather(
             }
             let u_choice = s.get_1d();
             let u_light = s.get_2d();
-            let at_y = ShadingPoint {
-                hit: &y,
-                material: &mat_y,
-                frame: &frame_y,
-                wo: wo_y,
-                wo_world: wo_y_world,
-            };
+            let at_y = ShadingPoint::new(&y, mat_y, wo_y_world);
             let direct = sample_direct(world, ctx.scene, &at_y, u_choice, u_light);
             rays += direct.shadow_rays;
             let at = EstimatePoint {

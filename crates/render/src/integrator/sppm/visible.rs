@@ -84,13 +84,7 @@ pub fn camera_sample(
         }
         let u_choice = sampler.get_1d();
         let u_light = sampler.get_2d();
-        let at = ShadingPoint {
-            hit: &hit,
-            material: &material,
-            frame: &frame,
-            wo,
-            wo_world,
-        };
+        let at = ShadingPoint::new(&hit, material, wo_world);
         let direct = sample_direct(world, scene, &at, u_choice, u_light);
         out.rays += direct.shadow_rays;
         out.ld += beta * direct.unweighted();
