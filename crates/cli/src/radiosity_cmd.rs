@@ -198,6 +198,8 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         resolution: args.resolution,
         integrator: None,
     };
+    // The context first: its world reads the light-sampler parameter.
+    let (ctx, w) = RenderContext::new(&desc, &overrides)?;
     let settings = RadiositySettings::from_desc(&desc.integrator)?;
     for w in desc
         .integrator
@@ -207,7 +209,6 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         eprintln!("{w}");
     }
     let (radiosity, warnings) = RadiosityIntegrator::new(&desc, settings)?;
-    let (ctx, w) = RenderContext::new(&desc, &overrides)?;
     for w in warnings.iter().chain(&w) {
         eprintln!("{w}");
     }

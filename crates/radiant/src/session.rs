@@ -16,12 +16,14 @@ pub struct Session {
 
 impl Session {
     pub fn new(desc: &SceneDesc, overrides: &Overrides) -> Result<Session, SceneError> {
+        // The context first: the world reads the integrator's light-sampler parameter,
+        // which must count as used when the integrator's parameters are checked.
+        let (ctx, mut warnings) = RenderContext::new(desc, overrides)?;
         let mut integrator_desc = desc.integrator.clone();
         if let Some(name) = &overrides.integrator {
             integrator_desc.name = name.clone();
         }
-        let (integrator, mut warnings) = integrator_from_desc(desc, &integrator_desc)?;
-        let (ctx, w) = RenderContext::new(desc, overrides)?;
+        let (integrator, w) = integrator_from_desc(desc, &integrator_desc)?;
         warnings.extend(w);
         Ok(Session {
             ctx,

@@ -82,13 +82,14 @@ pub fn world_ray_benchmark(desc: &SceneDesc, size: u32, repetitions: u32) -> Wor
         .enumerate()
         .filter_map(|(i, h)| {
             let mut s = PixelSample::for_stream(SamplerKind::Independent, 2, i as u64, 0);
-            let (l, _, _) = world.light_distribution.sample(s.get_1d());
-            let ls = world.lights.get(l)?.sample_li(h.p, s.get_2d(), scene)?;
+            let ctx = h.light_sample_context();
+            let chosen = world.light_sampler.sample(&ctx, s.get_1d())?;
+            let ls = world.lights[chosen.index].sample_li(&ctx, s.get_2d(), scene)?;
             let o = h.spawn_origin(ls.wi);
             let dist = if ls.at_infinity {
                 f32::INFINITY
             } else {
-                (ls.p - o).length() * 0.999
+                (ls.p_light.p - o).length() * 0.999
             };
             Some((crate::geometry::Ray::new(o, ls.wi), dist))
         })

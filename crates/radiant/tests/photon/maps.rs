@@ -78,7 +78,7 @@ fn projection_maps_cover_every_ray_that_hits_a_specular_object() {
             for _ in 0..100_000 {
                 let u_pos = Vec2::new(rng.uniform(), rng.uniform());
                 let u_dir = Vec2::new(rng.uniform(), rng.uniform());
-                let Some(e) = world.lights[l].sample_emission(u_pos, u_dir, scene) else {
+                let Some(e) = world.lights[l].sample_le(u_pos, u_dir, scene) else {
                     continue;
                 };
                 let inside = pm.contains(l, u_pos, u_dir);

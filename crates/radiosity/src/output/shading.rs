@@ -20,6 +20,7 @@ use radiant_render::geometry::Ray;
 use radiant_render::geometry::ray::offset_origin;
 use radiant_render::integrator::specular::specular_bounce;
 use radiant_render::integrator::{PixelEstimator, PixelId};
+use radiant_render::light::LightSampleContext;
 use radiant_render::sampler::PixelSample;
 use radiant_render::world::World;
 
@@ -193,24 +194,31 @@ impl<'a> Shading<'a> {
         let mut direct = Rgb::BLACK;
         let u_light = sampler.get_1d();
         let u_point = sampler.get_2d();
-        if !self.world.lights.is_empty() {
-            let (index, pmf, _) = self.world.light_distribution.sample(u_light);
-            let light = &self.world.lights[index];
-            if let Some(ls) = light.sample_li(p, u_point, self.world.scene_sphere()) {
-                let cos = n.dot(ls.wi);
-                if cos > 0.0 && ls.pdf > 0.0 && pmf > 0.0 {
-                    rays += 1;
-                    let o = offset_origin(p, n, ls.wi);
-                    let blocked = if ls.at_infinity {
-                        self.occluders.occluded(&Ray::new(o, ls.wi), f32::INFINITY)
-                    } else {
-                        let target = offset_origin(ls.p, ls.n, o - ls.p);
-                        self.occluders
-                            .occluded(&Ray::new(o, target - o), 1.0 - 1e-4)
-                    };
-                    if !blocked {
-                        direct = ls.li * (cos / (pmf * ls.pdf));
-                    }
+        let ctx = LightSampleContext::on_surface(p, n);
+        let sample = self
+            .world
+            .light_sampler
+            .sample(&ctx, u_light)
+            .and_then(|chosen| {
+                let light = &self.world.lights[chosen.index];
+                let ls = light.sample_li(&ctx, u_point, self.world.scene_sphere())?;
+                Some((chosen.pmf, ls))
+            });
+        if let Some((pmf, ls)) = sample {
+            let cos = n.dot(ls.wi);
+            if cos > 0.0 && ls.pdf > 0.0 {
+                rays += 1;
+                let o = offset_origin(p, n, ls.wi);
+                let blocked = if ls.at_infinity {
+                    self.occluders.occluded(&Ray::new(o, ls.wi), f32::INFINITY)
+                } else {
+                    let q = ls.p_light;
+                    let target = offset_origin(q.p, q.n, o - q.p);
+                    self.occluders
+                        .occluded(&Ray::new(o, target - o), 1.0 - 1e-4)
+                };
+                if !blocked {
+                    direct = ls.li * (cos / (pmf * ls.pdf));
                 }
             }
         }

@@ -41,7 +41,7 @@ use crate::settings::{FormFactorMethod, RadiositySettings, SolverKind};
 use crate::visibility::Visibility;
 use crate::visibility::bvh::NO_PATCH;
 use radiant_math::hash::Pcg32;
-use radiant_render::light::{Light, SceneSphere};
+use radiant_render::light::{Light, LightSampleContext, SceneSphere};
 
 #[derive(Debug, Error)]
 pub enum RadiosityError {
@@ -209,11 +209,12 @@ pub fn delta_light_irradiance<V: Visibility>(
             let mut rng = Pcg32::new(0, 0);
             rule.for_each_point(set.polygon(j).as_slice(), &mut rng, |x, w| {
                 for light in &delta {
-                    let Some(s) = light.sample_li(x.as_vec3(), Vec2::ZERO, sphere) else {
+                    let ctx = LightSampleContext::on_surface(x.as_vec3(), patch.normal.as_vec3());
+                    let Some(s) = light.sample_li(&ctx, Vec2::ZERO, sphere) else {
                         continue;
                     };
                     let cos = patch.normal.dot(s.wi.as_dvec3());
-                    if cos <= 0.0 || !vis.visible(x, s.p.as_dvec3(), j, NO_PATCH) {
+                    if cos <= 0.0 || !vis.visible(x, s.p_light.p.as_dvec3(), j, NO_PATCH) {
                         continue;
                     }
                     let li = s.li.to_array();

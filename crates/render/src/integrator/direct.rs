@@ -1,5 +1,5 @@
-//! Next-event estimation shared by the integrators: pick a light in proportion to its
-//! power, sample a point or direction on it, test visibility. The path tracer weights
+//! Next-event estimation shared by the integrators: pick a light by the world's light
+//! sampler, sample a point or direction on it, test visibility. The path tracer weights
 //! the result against BSDF sampling (multiple importance sampling); the photon mappers,
 //! which never pick up emission through BSDF-sampled rays at diffuse vertices, use it
 //! alone.
@@ -12,9 +12,36 @@ use crate::world::{NO_LIGHT, SurfaceHit, World};
 use radiant_math::Frame;
 use radiant_math::color::Rgb;
 
+/// A non-specular surface point being shaded, and the direction it is seen from.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingPoint<'a> {
+    pub hit: &'a SurfaceHit,
+    pub material: Material,
+    /// The shading frame (about `hit.ns`).
+    pub frame: Frame,
+    /// Unit direction towards the viewer, in `frame`.
+    pub wo: Vec3,
+    /// The same direction in render space.
+    pub wo_world: Vec3,
+}
+
+impl<'a> ShadingPoint<'a> {
+    /// `hit` with `material`, seen along the unit direction `wo_world`.
+    pub fn new(hit: &'a SurfaceHit, material: Material, wo_world: Vec3) -> ShadingPoint<'a> {
+        let frame = Frame::from_normal(hit.ns);
+        ShadingPoint {
+            hit,
+            material,
+            frame,
+            wo: frame.to_local(wo_world),
+            wo_world,
+        }
+    }
+}
+
 /// One unoccluded light sample seen from a surface point.
 #[derive(Clone, Copy, Debug)]
-pub struct DirectSample {
+pub struct DirectLight {
     /// BSDF value times |cos| at the receiver (shading frame).
     pub f: Rgb,
     /// Radiance arriving from the light (intensity / distance² for delta lights).
@@ -26,56 +53,72 @@ pub struct DirectSample {
     pub delta: bool,
 }
 
-impl DirectSample {
+impl DirectLight {
     /// The contribution without MIS: f L / pdf.
     pub fn unweighted(&self) -> Rgb {
         self.f * self.li * (1.0 / self.light_pdf)
     }
 }
 
-/// Samples one light for the non-specular surface point `hit` seen along `wo_world`
-/// (`wo` is the same direction in `frame`). `u_choice` picks the light, `u_light` the
-/// point on it. Adds 1 to `shadow_rays` when a visibility ray is traced. `None` when the
-/// sample carries nothing (back side, occluded, zero BSDF).
-#[allow(clippy::too_many_arguments)]
+/// What one light sample found, and what it cost.
+#[derive(Clone, Copy, Debug)]
+pub struct DirectSample {
+    /// `None` when the sample carries nothing (back side, occluded, zero BSDF).
+    pub light: Option<DirectLight>,
+    /// Visibility rays traced (0 or 1).
+    pub shadow_rays: u32,
+}
+
+impl DirectSample {
+    /// The contribution without MIS (black when nothing was found).
+    pub fn unweighted(&self) -> Rgb {
+        self.light.map_or(Rgb::BLACK, |d| d.unweighted())
+    }
+}
+
+/// Samples one light for the shading point `at`: `u_choice` picks the light (through
+/// the world's light sampler), `u_light` the point on it.
 pub fn sample_direct(
     world: &World,
     scene: SceneSphere,
-    hit: &SurfaceHit,
-    material: &Material,
-    frame: &Frame,
-    wo: Vec3,
-    wo_world: Vec3,
+    at: &ShadingPoint,
     u_choice: f32,
     u_light: Vec2,
-    shadow_rays: &mut u32,
-) -> Option<DirectSample> {
-    if world.lights.is_empty() {
-        return None;
-    }
-    let (light_index, pmf, _) = world.light_distribution.sample(u_choice);
-    let ls = world.lights[light_index].sample_li(hit.p, u_light, scene)?;
-    let wi = frame.to_local(ls.wi);
+) -> DirectSample {
+    let mut out = DirectSample {
+        light: None,
+        shadow_rays: 0,
+    };
+    let hit = at.hit;
+    let ctx = hit.light_sample_context();
+    let Some(chosen) = world.light_sampler.sample(&ctx, u_choice) else {
+        return out;
+    };
+    let Some(ls) = world.lights[chosen.index].sample_li(&ctx, u_light, scene) else {
+        return out;
+    };
+    let wi = at.frame.to_local(ls.wi);
     // Light must arrive on the side the path came from (the geometric test prevents
     // leaks through shading normals).
-    let same_side = ls.wi.dot(hit.ng) * wo_world.dot(hit.ng) > 0.0;
-    let f = material.eval(wo, wi) * wi.z.abs();
+    let same_side = ls.wi.dot(hit.ng) * at.wo_world.dot(hit.ng) > 0.0;
+    let f = at.material.eval(at.wo, wi) * wi.z.abs();
     if !same_side || f.is_black() {
-        return None;
+        return out;
     }
-    *shadow_rays += 1;
+    out.shadow_rays = 1;
     let unoccluded = if ls.at_infinity {
         !world.occluded(&hit.spawn_ray(ls.wi), f32::INFINITY)
     } else {
-        world.visible(hit.p, hit.ng, ls.p, ls.n)
+        world.visible(hit.p, hit.ng, ls.p_light.p, ls.p_light.n)
     };
-    unoccluded.then(|| DirectSample {
+    out.light = unoccluded.then(|| DirectLight {
         f,
         li: ls.li,
-        light_pdf: pmf * ls.pdf,
-        bsdf_pdf: material.pdf(wo, wi),
+        light_pdf: chosen.pmf * ls.pdf,
+        bsdf_pdf: at.material.pdf(at.wo, wi),
         delta: ls.delta,
-    })
+    });
+    out
 }
 
 /// Radiance emitted by the surface at `hit` towards `wo` (zero off emitters).

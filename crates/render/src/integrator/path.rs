@@ -2,10 +2,8 @@
 //! and multiple importance sampling (Veach & Guibas 1995, power heuristic), Russian
 //! roulette and specular chains. An iterative loop carrying a throughput — no recursion.
 
-use glam::Vec3;
-
 use crate::geometry::Ray;
-use crate::light::Light;
+use crate::light::{Light, LightSampleContext};
 use crate::material::{Material, TransportMode};
 use crate::sampler::PixelSample;
 use crate::world::{NO_LIGHT, World};
@@ -103,7 +101,9 @@ pub fn radiance(
     let mut eta_scale = 1.0f32;
     let mut specular_bounce = true;
     let mut prev_pdf = 0.0f32;
-    let mut prev_p = ray.o;
+    // The previous vertex as a receiver, for the light-sampling density of what a
+    // BSDF-sampled ray finds.
+    let mut prev_ctx = LightSampleContext::at_point(ray.o);
     let mut rays = 0u32;
     let mut depth = 0u32;
     loop {
@@ -117,8 +117,8 @@ pub fn radiance(
                 let w = if specular_bounce {
                     1.0
                 } else {
-                    let pdf_light = world.light_distribution.pmf(i)
-                        * light.pdf_li(prev_p, Vec3::ZERO, Vec3::ZERO, glam::Vec2::ZERO);
+                    let pdf_light = world.light_sampler.pmf(&prev_ctx, i)
+                        * light.pdf_li(&prev_ctx, ray.d, None);
                     power_heuristic(prev_pdf, pdf_light)
                 };
                 l += beta * le * w;
@@ -135,8 +135,8 @@ pub fn radiance(
                 let w = if specular_bounce {
                     1.0
                 } else {
-                    let pdf_light = world.light_distribution.pmf(hit.light as usize)
-                        * area.pdf_li(prev_p, hit.p, hit.ng, hit.uv);
+                    let pdf_light = world.light_sampler.pmf(&prev_ctx, hit.light as usize)
+                        * area.pdf_li(&prev_ctx, &hit.light_hit());
                     power_heuristic(prev_pdf, pdf_light)
                 };
                 l += beta * le * w;
@@ -155,21 +155,10 @@ pub fn radiance(
         let u_choice = sampler.get_1d();
         let u_light = sampler.get_2d();
         if !material.is_specular() {
-            let mut shadow_rays = 0;
-            let ds = direct::sample_direct(
-                world,
-                scene,
-                &hit,
-                &material,
-                &frame,
-                wo,
-                wo_world,
-                u_choice,
-                u_light,
-                &mut shadow_rays,
-            );
-            rays += shadow_rays;
-            if let Some(ds) = ds {
+            let at = direct::ShadingPoint::new(&hit, material, wo_world);
+            let ds = direct::sample_direct(world, scene, &at, u_choice, u_light);
+            rays += ds.shadow_rays;
+            if let Some(ds) = ds.light {
                 let w = if ds.delta {
                     1.0
                 } else {
@@ -201,7 +190,7 @@ pub fn radiance(
         }
         specular_bounce = bs.specular;
         prev_pdf = bs.pdf;
-        prev_p = hit.p;
+        prev_ctx = hit.light_sample_context();
         ray = hit.spawn_ray(wi);
 
         let u_rr = sampler.get_1d();

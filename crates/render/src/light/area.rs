@@ -4,7 +4,7 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{EmittedRay, LightSample};
+use super::{LightHit, LightLeSample, LightLiSample, LightPoint, LightSampleContext};
 use crate::geometry::Ray;
 use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
@@ -119,9 +119,12 @@ impl AreaLight {
         }
     }
 
-    pub fn sample_li(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+    /// A point on the light seen from `ctx`: spheres sample the cone they subtend (far
+    /// less variance than area sampling), everything else samples area, converted to
+    /// solid angle.
+    pub fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightLiSample> {
+        let p = ctx.p;
         let (q, n, pdf) = match &self.shape {
-            // Spheres: sample the cone they subtend (far less variance than area sampling).
             LightShape::Sphere {
                 sphere,
                 render_from_object,
@@ -148,20 +151,20 @@ impl AreaLight {
         if li.is_black() || wi == Vec3::ZERO {
             return None;
         }
-        Some(LightSample {
+        Some(LightLiSample {
             li,
             wi,
-            p: q,
-            n,
             pdf,
+            p_light: LightPoint { p: q, n },
             delta: false,
             at_infinity: false,
         })
     }
 
-    /// Solid-angle density of `sample_li` from `p` for the light point `q` (normal `n`,
-    /// surface parameters `uv`).
-    pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3, uv: Vec2) -> f32 {
+    /// Solid-angle density of `sample_li` from `ctx` for the direction that meets the
+    /// light at `hit`.
+    pub fn pdf_li(&self, ctx: &LightSampleContext, hit: &LightHit) -> f32 {
+        let (p, q, n) = (ctx.p, hit.p, hit.n);
         match &self.shape {
             LightShape::Sphere {
                 sphere,
@@ -172,15 +175,17 @@ impl AreaLight {
                 sphere.pdf_solid_angle(inv.point(p), inv.point(q))
             }
             LightShape::Bilinear { patch, .. } => {
-                area_pdf_to_solid_angle(patch.pdf_area(uv), p, q, n)
+                area_pdf_to_solid_angle(patch.pdf_area(hit.uv), p, q, n)
             }
             _ => area_pdf_to_solid_angle(1.0 / self.area(), p, q, n),
         }
     }
 
-    /// A photon ray: uniform position by area, cosine-distributed direction on the
-    /// emitting side(s). Its power is L π A (one side) — the light's whole power.
-    pub fn sample_emission(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmittedRay> {
+    /// A photon ray: position by area (uniform, or uniform in (u,v) on a curved patch),
+    /// cosine-distributed direction on the emitting side(s), the side chosen with
+    /// probability 1/2 when both emit. Its power is L π / pdf_pos per side — the
+    /// light's whole power when the position is uniform.
+    pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<LightLeSample> {
         let s = self.sample_area(u_pos)?;
         let (mut u, mut n) = (u_dir, s.n);
         let mut sides = 1.0;
@@ -195,10 +200,14 @@ impl AreaLight {
             }
             u.x = u.x.min(radiant_math::ONE_MINUS_EPSILON);
         }
-        let d = Frame::from_normal(n).to_world(sampling::cosine_hemisphere(u));
-        Some(EmittedRay {
+        let local = sampling::cosine_hemisphere(u);
+        let d = Frame::from_normal(n).to_world(local);
+        Some(LightLeSample {
             ray: Ray::new(offset_origin(s.p, n, d), d),
             n,
+            pdf_pos: s.pdf,
+            pdf_dir: sampling::cosine_hemisphere_pdf(local.z) / sides,
+            le: self.l,
             power: self.l * (PI * sides / s.pdf),
         })
     }

@@ -1,47 +1,117 @@
 //! Light sources. The set is closed (area, point, spot, distant, infinite), so it is
-//! one enum; each variant's sampling lives in its own file.
+//! one enum; each variant's sampling lives in its own file, and the choice among the
+//! lights is the [`LightSampler`]'s.
 //!
-//! Two kinds of sampling are offered: `sample_li` picks a direction towards the light
-//! from a receiving point (next-event estimation), `sample_emission` picks a ray
-//! leaving the light with the power it carries (photon tracing).
+//! Two kinds of sampling are offered (Pharr, Jakob & Humphreys, *Physically Based
+//! Rendering*, 4th ed., ch. 12): `sample_li` picks a direction towards the light as
+//! seen from a receiver described by a [`LightSampleContext`] (next-event
+//! estimation), with `pdf_li` the density of any direction; `sample_le` picks a ray
+//! leaving the light with the flux it carries (photon tracing).
 
 mod area;
 mod infinite;
 mod point;
+mod sampler;
 
 use glam::{Vec2, Vec3};
 
 pub use area::{AreaLight, LightShape};
+pub use sampler::{
+    LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, LightSampler, SampledLight, UnknownLightSampler,
+};
 
-use crate::geometry::Ray;
+use crate::geometry::{Aabb, Ray};
 use radiant_math::PI;
 use radiant_math::color::Rgb;
 
-/// A sampled direction towards a light, seen from a receiving point.
+/// The receiver a light is sampled from: a point with its geometric normal `n` and
+/// shading normal `ns`, both zero for a point in space (a camera ray's origin).
+///
+/// Surface points get theirs from the hit record (`SurfaceHit::light_sample_context`),
+/// so whatever a hit learns about itself (such as a bound on its rounding error, for
+/// offsetting the shadow ray's origin) reaches the lights through that one function.
+/// Today only `p` is used; `n` and `ns` are for samplers that look at the receiver's
+/// orientation (a light tree's importance, sampling only the visible hemisphere).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSampleContext {
+    pub p: Vec3,
+    pub n: Vec3,
+    pub ns: Vec3,
+}
+
+impl LightSampleContext {
+    /// A receiver in free space (no normal).
+    pub fn at_point(p: Vec3) -> LightSampleContext {
+        LightSampleContext {
+            p,
+            n: Vec3::ZERO,
+            ns: Vec3::ZERO,
+        }
+    }
+
+    /// A receiver on a surface without a separate shading normal (radiosity patches).
+    pub fn on_surface(p: Vec3, n: Vec3) -> LightSampleContext {
+        LightSampleContext { p, n, ns: n }
+    }
+}
+
+/// A point on a light: where a shadow ray towards it ends.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightPoint {
+    pub p: Vec3,
+    /// Surface normal at `p`; zero for lights without a surface (the shadow ray then
+    /// ends at `p` itself, not at a point offset off a surface).
+    pub n: Vec3,
+}
+
+/// Where a ray from a receiver met a light's surface: what `pdf_li` needs to give the
+/// density of that direction (a surface hit makes one by `SurfaceHit::light_hit`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightHit {
+    pub p: Vec3,
+    /// Geometric normal at `p` (either side).
+    pub n: Vec3,
+    /// Surface parameters (the bilinear patch's density depends on them).
+    pub uv: Vec2,
+}
+
+/// A direction towards a light sampled from a receiver.
 #[derive(Clone, Copy, Debug)]
-pub struct LightSample {
+pub struct LightLiSample {
     /// Radiance arriving along `-wi` (for delta lights: intensity / distance²).
     pub li: Rgb,
     /// Unit direction from the receiver towards the light.
     pub wi: Vec3,
-    /// The sampled point on the light (far away for distant and infinite lights).
-    pub p: Vec3,
-    /// Surface normal at `p`; zero for lights without a surface.
-    pub n: Vec3,
     /// Density per solid angle; for delta lights, 1 (the choice is certain).
     pub pdf: f32,
+    /// The sampled point on the light (far away for distant and infinite lights).
+    pub p_light: LightPoint,
     pub delta: bool,
-    /// True when `p` lies at infinity: visibility is tested along a ray, not a segment.
+    /// True when `p_light` lies at infinity: visibility is tested along a ray, not a
+    /// segment.
     pub at_infinity: bool,
 }
 
-/// A ray leaving a light and the power it carries, for photon tracing: `power` is
-/// Le cos / (pdf_position pdf_direction) — the flux of one sample from this light.
+/// A ray leaving a light, for photon tracing (and any method that starts paths at
+/// the lights).
 #[derive(Clone, Copy, Debug)]
-pub struct EmittedRay {
+pub struct LightLeSample {
     pub ray: Ray,
-    /// Normal at the origin (zero for point-like and infinite lights).
+    /// Normal at the origin, on the emitting side (zero for point-like and infinite
+    /// lights).
     pub n: Vec3,
+    /// Density of the origin per unit area: on the light's surface, or on the disk
+    /// that rays of lights at infinity start from; 1 for a point or spot light's
+    /// certain position.
+    pub pdf_pos: f32,
+    /// Density of the direction per unit solid angle; 1 for a distant light's certain
+    /// direction.
+    pub pdf_dir: f32,
+    /// Radiance leaving along the ray (intensity for point and spot lights).
+    pub le: Rgb,
+    /// The flux of one sample from this light, le |cos| / (pdf_pos pdf_dir), in closed
+    /// form (for a cosine-sampled area light: L π A per side, without the cosine's
+    /// round-off).
     pub power: Rgb,
 }
 
@@ -50,6 +120,18 @@ pub struct EmittedRay {
 pub struct SceneSphere {
     pub center: Vec3,
     pub radius: f32,
+}
+
+impl SceneSphere {
+    /// The sphere around `bounds` (its radius at least 10⁻³, so that the disks rays of
+    /// lights at infinity start from never vanish).
+    pub fn around(bounds: &Aabb) -> SceneSphere {
+        let (center, radius) = bounds.bounding_sphere();
+        SceneSphere {
+            center,
+            radius: radius.max(1e-3),
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -107,9 +189,17 @@ impl Light {
         }
     }
 
-    pub fn sample_li(&self, p: Vec3, u: Vec2, scene: SceneSphere) -> Option<LightSample> {
+    /// A direction towards the light from `ctx`, or `None` when the sample carries
+    /// nothing (back side, outside a spot's cone).
+    pub fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Vec2,
+        scene: SceneSphere,
+    ) -> Option<LightLiSample> {
+        let p = ctx.p;
         match self {
-            Light::Area(a) => a.sample_li(p, u),
+            Light::Area(a) => a.sample_li(ctx, u),
             Light::Point {
                 position,
                 intensity,
@@ -129,26 +219,29 @@ impl Light {
             Light::Distant {
                 direction,
                 radiance,
-            } => Some(LightSample {
+            } => Some(LightLiSample {
                 li: *radiance,
                 wi: -*direction,
-                p: p - *direction * (2.0 * scene.radius + (p - scene.center).length()),
-                n: Vec3::ZERO,
                 pdf: 1.0,
+                p_light: LightPoint {
+                    p: p - *direction * (2.0 * scene.radius + (p - scene.center).length()),
+                    n: Vec3::ZERO,
+                },
                 delta: true,
                 at_infinity: true,
             }),
-            Light::Infinite { radiance } => infinite::sample_li(p, *radiance, u, scene),
+            Light::Infinite { radiance } => infinite::sample_li(ctx, *radiance, u, scene),
         }
     }
 
-    /// Solid-angle density with which `sample_li` from `p` would have produced the
-    /// direction towards point `q` (normal `n`, surface parameters `uv`) on this light.
-    /// Zero for delta lights.
-    pub fn pdf_li(&self, p: Vec3, q: Vec3, n: Vec3, uv: Vec2) -> f32 {
+    /// Solid-angle density with which `sample_li` from `ctx` produces the unit
+    /// direction `wi`. Area lights need `hit`, where the ray along `wi` met them (zero
+    /// without it); lights at infinity need only `wi`. Zero for delta lights, which no
+    /// ray finds.
+    pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3, hit: Option<&LightHit>) -> f32 {
         match self {
-            Light::Area(a) => a.pdf_li(p, q, n, uv),
-            Light::Infinite { .. } => infinite::PDF,
+            Light::Area(a) => hit.map_or(0.0, |h| a.pdf_li(ctx, h)),
+            Light::Infinite { .. } => infinite::pdf_li(wi),
             _ => 0.0,
         }
     }
@@ -161,14 +254,11 @@ impl Light {
         }
     }
 
-    pub fn sample_emission(
-        &self,
-        u_pos: Vec2,
-        u_dir: Vec2,
-        scene: SceneSphere,
-    ) -> Option<EmittedRay> {
+    /// A ray leaving the light: `u_pos` places its origin, `u_dir` its direction.
+    /// `None` when the sample carries nothing.
+    pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2, scene: SceneSphere) -> Option<LightLeSample> {
         match self {
-            Light::Area(a) => a.sample_emission(u_pos, u_dir),
+            Light::Area(a) => a.sample_le(u_pos, u_dir),
             Light::Point {
                 position,
                 intensity,
@@ -192,10 +282,7 @@ impl Light {
                 radiance,
             } => Some(infinite::emit_parallel(*direction, *radiance, u_pos, scene)),
             Light::Infinite { radiance } => {
-                let d = -radiant_math::sampling::uniform_sphere(u_dir);
-                let mut e = infinite::emit_parallel(d, *radiance, u_pos, scene);
-                e.power *= 1.0 / radiant_math::sampling::UNIFORM_SPHERE_PDF;
-                Some(e)
+                Some(infinite::emit_infinite(*radiance, u_pos, u_dir, scene))
             }
         }
     }

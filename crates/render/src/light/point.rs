@@ -2,23 +2,25 @@
 
 use glam::{Vec2, Vec3};
 
-use super::{EmittedRay, LightSample};
+use super::{LightLeSample, LightLiSample, LightPoint};
 use crate::geometry::Ray;
 use radiant_math::color::Rgb;
 use radiant_math::{Frame, sampling};
 
-pub(super) fn sample_point(p: Vec3, position: Vec3, intensity: Rgb) -> Option<LightSample> {
+pub(super) fn sample_point(p: Vec3, position: Vec3, intensity: Rgb) -> Option<LightLiSample> {
     let d = position - p;
     let dist2 = d.length_squared();
     if dist2 == 0.0 {
         return None;
     }
-    Some(LightSample {
+    Some(LightLiSample {
         li: intensity / dist2,
         wi: d / dist2.sqrt(),
-        p: position,
-        n: Vec3::ZERO,
         pdf: 1.0,
+        p_light: LightPoint {
+            p: position,
+            n: Vec3::ZERO,
+        },
         delta: true,
         at_infinity: false,
     })
@@ -42,14 +44,18 @@ pub(super) fn spot_falloff(
     t * t * (3.0 - 2.0 * t)
 }
 
-pub(super) fn emit_point(position: Vec3, intensity: Rgb, u: Vec2) -> EmittedRay {
-    EmittedRay {
+pub(super) fn emit_point(position: Vec3, intensity: Rgb, u: Vec2) -> LightLeSample {
+    LightLeSample {
         ray: Ray::new(position, sampling::uniform_sphere(u)),
         n: Vec3::ZERO,
+        pdf_pos: 1.0,
+        pdf_dir: sampling::UNIFORM_SPHERE_PDF,
+        le: intensity,
         power: intensity / sampling::UNIFORM_SPHERE_PDF,
     }
 }
 
+/// Directions uniform in the spot's whole cone; the falloff goes into the power.
 pub(super) fn emit_spot(
     position: Vec3,
     axis: Vec3,
@@ -57,13 +63,17 @@ pub(super) fn emit_spot(
     cos_falloff_start: f32,
     cos_total_width: f32,
     u: Vec2,
-) -> Option<EmittedRay> {
+) -> Option<LightLeSample> {
     let local = sampling::uniform_cone(u, cos_total_width);
     let d = Frame::from_normal(axis).to_world(local);
     let falloff = spot_falloff(d, axis, cos_falloff_start, cos_total_width);
-    (falloff > 0.0).then(|| EmittedRay {
+    let pdf_dir = sampling::uniform_cone_pdf(cos_total_width);
+    (falloff > 0.0).then(|| LightLeSample {
         ray: Ray::new(position, d),
         n: Vec3::ZERO,
-        power: intensity * (falloff / sampling::uniform_cone_pdf(cos_total_width)),
+        pdf_pos: 1.0,
+        pdf_dir,
+        le: intensity * falloff,
+        power: intensity * (falloff / pdf_dir),
     })
 }

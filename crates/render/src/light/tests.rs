@@ -17,13 +17,22 @@ fn u2(rng: &mut Pcg32) -> Vec2 {
     Vec2::new(rng.uniform(), rng.uniform())
 }
 
+/// The sampled point as a ray would find it (shapes whose density ignores uv).
+fn hit_at(q: LightPoint) -> LightHit {
+    LightHit {
+        p: q.p,
+        n: q.n,
+        uv: Vec2::ZERO,
+    }
+}
+
 /// Irradiance E = mean(Li cos / pdf) at `p` with normal `n`, with its standard error.
 fn irradiance(light: &Light, p: Vec3, n: Vec3, samples: usize) -> (f64, f64) {
     let mut rng = Pcg32::new(17, 4);
     let (mut s, mut s2) = (0.0f64, 0.0f64);
     for _ in 0..samples {
         let v = light
-            .sample_li(p, u2(&mut rng), scene())
+            .sample_li(&LightSampleContext::at_point(p), u2(&mut rng), scene())
             .map_or(0.0, |ls| (ls.li.g * ls.wi.dot(n).max(0.0) / ls.pdf) as f64);
         s += v;
         s2 += v * v;
@@ -96,9 +105,10 @@ fn sphere_light_irradiance_is_pi_l_sin2() {
     assert!((e - exact).abs() < 4.0 * se + 1e-6, "{e} vs {exact} ({se})");
     // The density reported for a sample equals pdf_li for its point.
     let mut rng = Pcg32::new(1, 1);
+    let ctx = LightSampleContext::at_point(Vec3::ZERO);
     for _ in 0..100 {
-        let s = light.sample_li(Vec3::ZERO, u2(&mut rng), scene()).unwrap();
-        let pdf = light.pdf_li(Vec3::ZERO, s.p, s.n, Vec2::ZERO);
+        let s = light.sample_li(&ctx, u2(&mut rng), scene()).unwrap();
+        let pdf = light.pdf_li(&ctx, s.wi, Some(&hit_at(s.p_light)));
         assert!((pdf - s.pdf).abs() < 1e-3 * s.pdf, "{pdf} vs {}", s.pdf);
     }
 }
@@ -106,11 +116,11 @@ fn sphere_light_irradiance_is_pi_l_sin2() {
 #[test]
 fn triangle_light_pdf_li_matches_its_samples() {
     let light = &square_light(2.0, 3.0, 1.0)[0];
-    let p = Vec3::new(0.3, -0.2, 0.0);
+    let ctx = LightSampleContext::at_point(Vec3::new(0.3, -0.2, 0.0));
     let mut rng = Pcg32::new(2, 2);
     for _ in 0..100 {
-        let s = light.sample_li(p, u2(&mut rng), scene()).unwrap();
-        let pdf = light.pdf_li(p, s.p, s.n, Vec2::ZERO);
+        let s = light.sample_li(&ctx, u2(&mut rng), scene()).unwrap();
+        let pdf = light.pdf_li(&ctx, s.wi, Some(&hit_at(s.p_light)));
         assert!((pdf - s.pdf).abs() < 1e-3 * s.pdf);
     }
 }
@@ -145,7 +155,7 @@ fn emitted_power_equals_light_power() {
         let (mut s, mut s2) = (0.0f64, 0.0f64);
         for _ in 0..n {
             let v = light
-                .sample_emission(u2(&mut rng), u2(&mut rng), scene())
+                .sample_le(u2(&mut rng), u2(&mut rng), scene())
                 .map_or(0.0, |e| e.power.g as f64);
             s += v;
             s2 += v * v;

@@ -8,9 +8,12 @@ use super::{NO_LIGHT, World};
 use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
-use crate::light::{AreaLight, Light, LightShape, SceneSphere};
+use crate::light::{
+    AreaLight, LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, Light, LightSampler, LightShape,
+    SceneSphere,
+};
 use crate::material::Material;
-use radiant_math::{Distribution1D, Transform};
+use radiant_math::Transform;
 use radiant_scene::{
     AreaLightDesc, Geometry, LightDesc, SceneDesc, SceneError, ShapeDesc, Warning,
 };
@@ -61,35 +64,51 @@ impl World {
         top.finish(&prototypes);
         let bounds = top.bounds();
 
-        let mut world = World {
+        lights.extend(desc.lights.iter().map(light_from_desc));
+        let light_sampler =
+            light_sampler_from_desc(desc, &lights, SceneSphere::around(&bounds), &mut warnings)?;
+        let world = World {
             geometry: top,
             prototypes,
             materials,
             lights,
-            light_distribution: Distribution1D::default(),
+            light_sampler,
             bounds,
         };
-        let scene = world.scene_sphere();
-        for l in &desc.lights {
-            world.lights.push(light_from_desc(l));
-        }
-        let powers: Vec<f32> = world
-            .lights
-            .iter()
-            .map(|l| l.power(scene).average())
-            .collect();
-        world.light_distribution = Distribution1D::new(&powers);
         Ok((world, warnings))
     }
 
     /// The scene's bounding sphere, for lights at infinity.
     pub fn scene_sphere(&self) -> SceneSphere {
-        let (center, radius) = self.bounds.bounding_sphere();
-        SceneSphere {
-            center,
-            radius: radius.max(1e-3),
-        }
+        SceneSphere::around(&self.bounds)
     }
+}
+
+/// The light sampler the integrator's `"string lightsampler"` names (default
+/// `"power"`); pbrt-v4's names that radiant lacks get the default, with a warning.
+fn light_sampler_from_desc(
+    desc: &SceneDesc,
+    lights: &[Light],
+    scene: SceneSphere,
+    warnings: &mut Vec<Warning>,
+) -> Result<LightSampler, BuildError> {
+    let params = &desc.integrator.params;
+    let name = params.string(LIGHT_SAMPLER_PARAM, LIGHT_SAMPLER_NAMES[0].into())?;
+    let loc = params
+        .lookup(LIGHT_SAMPLER_PARAM)
+        .map_or(&desc.integrator.loc, |p| &p.loc);
+    let (sampler, stand_in) = LightSampler::by_name(&name, lights, scene)
+        .map_err(|e| SceneError::at(loc, e.to_string()))?;
+    if stand_in {
+        warnings.push(Warning {
+            loc: loc.clone(),
+            message: format!(
+                "light sampler \"{name}\" is not supported; using \"{}\"",
+                sampler.name()
+            ),
+        });
+    }
+    Ok(sampler)
 }
 
 fn light_from_desc(l: &LightDesc) -> Light {

@@ -14,9 +14,8 @@ pub use shapes::ShapeSet;
 
 use crate::geometry::ray::offset_origin;
 use crate::geometry::{Aabb, Ray};
-use crate::light::Light;
+use crate::light::{Light, LightHit, LightSampleContext, LightSampler};
 use crate::material::Material;
-use radiant_math::Distribution1D;
 
 /// No light attached (in per-primitive light indices).
 pub const NO_LIGHT: u32 = u32::MAX;
@@ -46,6 +45,24 @@ impl SurfaceHit {
     pub fn spawn_ray(&self, w: Vec3) -> Ray {
         Ray::new(self.spawn_origin(w), w)
     }
+
+    /// This point as a receiver of light sampling.
+    pub fn light_sample_context(&self) -> LightSampleContext {
+        LightSampleContext {
+            p: self.p,
+            n: self.ng,
+            ns: self.ns,
+        }
+    }
+
+    /// This point as where a ray found an area light, for the light's `pdf_li`.
+    pub fn light_hit(&self) -> LightHit {
+        LightHit {
+            p: self.p,
+            n: self.ng,
+            uv: self.uv,
+        }
+    }
 }
 
 /// Everything an integrator traces against.
@@ -55,8 +72,8 @@ pub struct World {
     pub(crate) prototypes: Vec<ShapeSet>,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
-    /// Picks a light in proportion to its emitted power.
-    pub light_distribution: Distribution1D,
+    /// Chooses among `lights` for next-event estimation and photon emission.
+    pub light_sampler: LightSampler,
     pub bounds: Aabb,
 }
 

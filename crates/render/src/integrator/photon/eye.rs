@@ -10,12 +10,12 @@ use super::record::FIRST_DIFFUSE;
 use super::settings::Visualize;
 use super::{PhotonMaps, facing};
 use crate::geometry::Ray;
-use crate::integrator::direct::{environment, sample_direct, surface_emission};
+use crate::integrator::direct::{ShadingPoint, environment, sample_direct, surface_emission};
 use crate::integrator::specular::specular_bounce;
 use crate::light::SceneSphere;
-use crate::material::{Material, TransportMode};
+use crate::material::TransportMode;
 use crate::sampler::PixelSample;
-use crate::world::{SurfaceHit, World};
+use crate::world::World;
 use radiant_math::color::Rgb;
 use radiant_math::{Frame, INV_PI};
 use radiant_scene::SamplerKind;
@@ -121,20 +121,18 @@ pub fn radiance(
                 l += beta * emitted;
                 let u_choice = sampler.get_1d();
                 let u_light = sampler.get_2d();
-                let direct = sample_direct(
-                    world, ctx.scene, &hit, &material, &frame, wo, wo_world, u_choice, u_light,
-                    &mut rays,
-                )
-                .map_or(Rgb::BLACK, |d| d.unweighted());
+                let at = ShadingPoint::new(&hit, material, wo_world);
+                let direct = sample_direct(world, ctx.scene, &at, u_choice, u_light);
+                rays += direct.shadow_rays;
                 let caustic = estimate(&maps.caustic, 0, &mut scratch.caustic);
                 let indirect = if settings.final_gather_samples > 0 {
-                    final_gather(
-                        ctx, &hit, &material, &frame, wo, wo_world, gather, scratch, &mut rays,
-                    )
+                    let (gathered, gather_rays) = final_gather(ctx, &at, gather, scratch);
+                    rays += gather_rays;
+                    gathered
                 } else {
                     estimate(&maps.global, 0, &mut scratch.global)
                 };
-                direct + caustic + indirect
+                direct.unweighted() + caustic + indirect
             }
             Visualize::Caustic => estimate(&maps.caustic, 0, &mut scratch.caustic),
             Visualize::Global => estimate(&maps.global, FIRST_DIFFUSE, &mut scratch.global),
@@ -170,19 +168,15 @@ fn photon_dots(maps: &PhotonMaps, at: &EstimatePoint, radius: f32) -> Rgb {
 /// leaving y is next-event estimation plus the precomputed irradiance (global and
 /// caustic maps) times the diffuse reflectance. Emission reached by gather rays is not
 /// counted (next-event estimation and the caustic map at the camera path's point hold
-/// those paths).
-#[allow(clippy::too_many_arguments)]
+/// those paths). Returns the radiance and the number of rays traced.
 fn final_gather(
     ctx: &EyeContext,
-    x: &SurfaceHit,
-    material: &Material,
-    frame: &Frame,
-    wo: Vec3,
-    wo_world: Vec3,
+    at: &ShadingPoint,
     gather: GatherStream,
     scratch: &mut EyeScratch,
-    rays: &mut u32,
-) -> Rgb {
+) -> (Rgb, u32) {
+    let (x, material, frame, wo, wo_world) = (at.hit, at.material, at.frame, at.wo, at.wo_world);
+    let mut rays = 0u32;
     let world = ctx.world;
     let maps = ctx.maps;
     let settings = &maps.settings;
@@ -202,7 +196,7 @@ fn final_gather(
         let mut beta = bs.f * (bs.wi.z.abs() / bs.pdf);
         let mut ray = x.spawn_ray(wi);
         for _ in 0..settings.max_depth {
-            *rays += 1;
+            rays += 1;
             let Some(y) = world.intersect(&ray, f32::INFINITY) else {
                 break;
             };
@@ -219,20 +213,19 @@ fn final_gather(
             }
             let u_choice = s.get_1d();
             let u_light = s.get_2d();
-            let direct = sample_direct(
-                world, ctx.scene, &y, &mat_y, &frame_y, wo_y, wo_y_world, u_choice, u_light, rays,
-            )
-            .map_or(Rgb::BLACK, |d| d.unweighted());
+            let at_y = ShadingPoint::new(&y, mat_y, wo_y_world);
+            let direct = sample_direct(world, ctx.scene, &at_y, u_choice, u_light);
+            rays += direct.shadow_rays;
             let at = EstimatePoint {
                 p: y.p,
                 n: facing(y.ng, wo_y_world),
             };
             let irradiance = gathered_irradiance(maps, &at, scratch);
-            sum += beta * (direct + irradiance * mat_y.diffuse_albedo() * INV_PI);
+            sum += beta * (direct.unweighted() + irradiance * mat_y.diffuse_albedo() * INV_PI);
             break;
         }
     }
-    sum * (1.0 / n.max(1) as f32)
+    (sum * (1.0 / n.max(1) as f32), rays)
 }
 
 /// The irradiance a gather ray reads where it lands at `at`: that of the nearest

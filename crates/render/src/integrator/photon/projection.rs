@@ -241,11 +241,11 @@ fn position_ball(light: &Light, c: u32, res: u32, scene: SceneSphere) -> Option<
     let u_dir = Vec2::splat(0.5);
     let (cx, cy) = (c % res, c / res);
     let centre = light
-        .sample_emission(cell_centre(cx, cy, res), u_dir, scene)?
+        .sample_le(cell_centre(cx, cy, res), u_dir, scene)?
         .ray
         .o;
     let pts: Vec<Vec3> = boundary(cx, cy, res)
-        .filter_map(|u| light.sample_emission(u, u_dir, scene).map(|e| e.ray.o))
+        .filter_map(|u| light.sample_le(u, u_dir, scene).map(|e| e.ray.o))
         .collect();
     let r = pts
         .iter()
@@ -266,14 +266,14 @@ fn direction_cone(
 ) -> Option<(Vec3, f32)> {
     let (cx, cy) = (c % res, c / res);
     let axis = light
-        .sample_emission(u_pos, cell_centre(cx, cy, res), scene)?
+        .sample_le(u_pos, cell_centre(cx, cy, res), scene)?
         .ray
         .d
         .normalize();
     let dirs: Vec<Vec3> = boundary(cx, cy, res)
         .filter_map(|u| {
             light
-                .sample_emission(u_pos, u, scene)
+                .sample_le(u_pos, u, scene)
                 .map(|e| e.ray.d.normalize())
         })
         .collect();
@@ -323,7 +323,7 @@ fn build_light(
     // point-like and distant ones): compute the cones once.
     let cones: Vec<Option<(Vec3, f32)>> = if dir_res == 1 {
         let d = light
-            .sample_emission(Vec2::splat(0.5), Vec2::splat(0.5), scene)
+            .sample_le(Vec2::splat(0.5), Vec2::splat(0.5), scene)
             .map(|e| (e.ray.d.normalize(), 0.0));
         vec![d]
     } else {

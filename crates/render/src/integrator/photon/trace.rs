@@ -86,8 +86,8 @@ pub fn emit(
     let scene = world.scene_sphere();
     let (light, pmf, u_pos, u_dir, fraction) = match projection {
         None => {
-            let (l, pmf, _) = world.light_distribution.sample(u_light);
-            (l, pmf, u_pos, u_dir, 1.0)
+            let chosen = world.light_sampler.sample_emission_light(u_light)?;
+            (chosen.index, chosen.pmf, u_pos, u_dir, 1.0)
         }
         Some(pm) => {
             let (l, pmf, u_cell) = pm.distribution().sample(u_light);
@@ -98,7 +98,7 @@ pub fn emit(
     if pmf <= 0.0 {
         return None;
     }
-    let e = world.lights[light].sample_emission(u_pos, u_dir, scene)?;
+    let e = world.lights[light].sample_le(u_pos, u_dir, scene)?;
     let power = e.power * (fraction / (pmf as f64 * n_total) as f32);
     (!power.is_black()).then_some((e.ray, power))
 }

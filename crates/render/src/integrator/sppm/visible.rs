@@ -11,7 +11,7 @@
 use glam::Vec3;
 
 use crate::context::RenderContext;
-use crate::integrator::direct::{environment, sample_direct, surface_emission};
+use crate::integrator::direct::{ShadingPoint, environment, sample_direct, surface_emission};
 use crate::integrator::specular::specular_bounce;
 use radiant_math::Frame;
 use radiant_math::color::Rgb;
@@ -84,20 +84,10 @@ pub fn camera_sample(
         }
         let u_choice = sampler.get_1d();
         let u_light = sampler.get_2d();
-        if let Some(d) = sample_direct(
-            world,
-            scene,
-            &hit,
-            &material,
-            &frame,
-            wo,
-            wo_world,
-            u_choice,
-            u_light,
-            &mut out.rays,
-        ) {
-            out.ld += beta * d.unweighted();
-        }
+        let at = ShadingPoint::new(&hit, material, wo_world);
+        let direct = sample_direct(world, scene, &at, u_choice, u_light);
+        out.rays += direct.shadow_rays;
+        out.ld += beta * direct.unweighted();
         out.vp = VisiblePoint {
             p: hit.p,
             n: if hit.ng.dot(wo_world) >= 0.0 {
