@@ -82,9 +82,7 @@ fn diffuse_sampling_follows_its_pdf_from_every_side() {
                         TransportMode::Importance
                     };
                     let s = m.sample(wo, u.u1, u.u2, mode)?;
-                    if s.specular
-                        || s.f != m.eval(wo, s.wi)
-                        || !close_rgb(weight(&s), albedo, 1e-5)
+                    if s.specular || s.f != m.eval(wo, s.wi) || !close_rgb(weight(&s), albedo, 1e-5)
                     {
                         bad.push(format!("{s:?}"));
                     }
@@ -270,7 +268,12 @@ fn dielectric_chooses_reflection_and_refraction_by_fresnel() {
 /// index) every sample is the mirror direction with pdf 1 and weight 1.
 #[test]
 fn dielectric_reflects_totally_beyond_the_critical_angle() {
-    let cases = [(1.5f32, -0.74f32), (1.5, -0.3), (1.5, -1e-3), (1.0 / 1.5, 0.5)];
+    let cases = [
+        (1.5f32, -0.74f32),
+        (1.5, -0.3),
+        (1.5, -1e-3),
+        (1.0 / 1.5, 0.5),
+    ];
     let mut rng = Pcg32::new(17, 3);
     for (eta, cos_o) in cases {
         let (n_o, n_t) = if cos_o > 0.0 { (1.0, eta) } else { (eta, 1.0) };
@@ -394,7 +397,9 @@ fn mirror_and_conductors_reflect_exactly_with_fresnel_weight() {
                     mirror,
                 )]);
             for (m, expected) in cases {
-                let s = m.sample(wo, u1, u2, mode).expect("a mirror always reflects");
+                let s = m
+                    .sample(wo, u1, u2, mode)
+                    .expect("a mirror always reflects");
                 assert_eq!(s.wi, reflected, "{m:?}, wo {wo}");
                 assert!(s.specular && s.pdf == 1.0, "{m:?}: {s:?}");
                 assert_eq!(m.eval(wo, s.wi), Rgb::BLACK);

@@ -43,12 +43,7 @@ fn camera(name: &str, aperture_mm: f64, focus_m: f64) -> RealisticCamera {
 }
 
 /// The film centre, two field points at azimuths off the axes, and the corner.
-const RASTERS: [[f32; 2]; 4] = [
-    [500.0, 500.0],
-    [700.0, 380.0],
-    [130.0, 880.0],
-    [999.5, 0.5],
-];
+const RASTERS: [[f32; 2]; 4] = [[500.0, 500.0], [700.0, 380.0], [130.0, 880.0], [999.5, 0.5]];
 
 /// Pupil samples for the film point under `raster` against the uniform density over
 /// the bucket's rectangle turned to the film point's azimuth, on a rectangle domain
@@ -61,7 +56,10 @@ fn pupil_follows_uniform_density(name: &str, camera: &RealisticCamera, raster: V
     let Some(rect) = pupil.rect_for_radius(r) else {
         for i in 0..100 {
             let u = DVec2::new(i as f64 / 100.0, 0.37);
-            assert!(pupil.sample(film, u).is_none(), "{name}: a sample without bounds");
+            assert!(
+                pupil.sample(film, u).is_none(),
+                "{name}: a sample without bounds"
+            );
         }
         return;
     };

@@ -1,0 +1,113 @@
+//! Filter importance sampling (Ernst, Stamminger & Greiner 2006) against the filters,
+//! by Pearson's chi-square test (`radiant_testkit::chi2`): every filter's offsets must
+//! follow |f| / ∫|f| over the rectangle of its support, and the weights must be right —
+//! f / (pdf ∫f) per sample (so the density they imply is the sampler's), with mean
+//! ∫f / ∫|f|, which is 1 for the filters here (none has negative lobes).
+
+use radiant_image::Filter;
+use radiant_math::Vec2;
+use radiant_testkit::chi2::{ChiSquareReport, ChiSquareTest, Domain};
+
+const ALPHA: f64 = 0.01;
+/// Every chi-square test in this file.
+const CHI2_TESTS: u32 = 7;
+const SAMPLES: u64 = 1_000_000;
+
+fn check(report: &ChiSquareReport) {
+    println!(
+        "{}: statistic {:.1}, dof {}, p-value {:.3e}, integral {:.6}, no sample {}",
+        report.name,
+        report.statistic,
+        report.dof,
+        report.p_value,
+        report.pdf_integral,
+        report.no_sample
+    );
+    report.assert_passes(ALPHA, CHI2_TESTS);
+}
+
+/// The filters the renderer offers, with square and elongated supports.
+fn filters() -> Vec<(&'static str, Filter)> {
+    vec![
+        ("box_pixel", Filter::box_filter(Vec2::splat(0.5))),
+        ("box_wide", Filter::box_filter(Vec2::new(1.5, 0.75))),
+        ("triangle", Filter::triangle(Vec2::splat(1.0))),
+        ("triangle_wide", Filter::triangle(Vec2::new(2.0, 1.25))),
+        ("gaussian_default", Filter::default()),
+        ("gaussian_wide", Filter::gaussian(Vec2::new(2.0, 1.0), 0.8)),
+        ("gaussian_narrow", Filter::gaussian(Vec2::splat(1.0), 0.25)),
+    ]
+}
+
+/// How far the density a Gaussian weight implies, f / (weight ∫f), may be from f / ∫f:
+/// the sampler inverts a piecewise-linear interpolant of each axis, whose relative error
+/// is largest in the last segment before the radius (measured weights per axis within
+/// 1.4e-3 of 1; the product of both axes within 3e-3).
+const GAUSSIAN_PDF_TOLERANCE: f64 = 3e-3;
+
+/// Offsets over the filter's support against f / ∫f; each sample's weight gives the
+/// density it claims, f / (weight ∫f), which must be f / ∫f too (exactly for box and
+/// tent, whose weights are 1). The mean weight must be ∫f / ∫|f| = 1 within its
+/// standard error, and ∫f the harness's integral of f over the cells.
+#[test]
+fn filter_offsets_follow_the_normalised_filter() {
+    for (seed, (name, filter)) in filters().into_iter().enumerate() {
+        let radius = filter.radius();
+        let integral = filter.integral() as f64;
+        assert!(integral > 0.0, "{name}");
+        let gaussian = matches!(filter, Filter::Gaussian { .. });
+        let (mut n, mut sum, mut sum2) = (0u64, 0.0f64, 0.0f64);
+        let report = ChiSquareTest::new(
+            name,
+            Domain::Rectangle {
+                min: -radius,
+                max: radius,
+            },
+        )
+        .samples(SAMPLES)
+        .seed(seed as u64 + 1)
+        .pdf_tolerance(if gaussian {
+            GAUSSIAN_PDF_TOLERANCE
+        } else {
+            1e-6
+        })
+        .run_with_pdf(
+            |u| {
+                let s = filter.sample(u.u2);
+                let w = s.weight as f64;
+                n += 1;
+                sum += w;
+                sum2 += w * w;
+                assert!(w.is_finite() && w > 0.0, "{name}: weight {w}");
+                if !gaussian {
+                    assert_eq!(s.weight, 1.0, "{name}: {s:?}");
+                }
+                // An offset on the support's rim (u = 0) has f = 0 and weight no
+                // density; it counts as no sample.
+                let f = filter.eval(s.offset) as f64;
+                (f > 0.0).then_some((s.offset, f / (w * integral)))
+            },
+            |p| filter.eval(p).abs() as f64 / integral,
+        );
+        check(&report);
+        // The harness integrates f / ∫f over the cells: ∫f must be the filter's integral.
+        assert!(
+            (report.pdf_integral - 1.0).abs() < 1e-3,
+            "{name}: the filter's integral {integral} is off by {}",
+            report.pdf_integral - 1.0
+        );
+        // Samples with f = 0 lie on the support's rim, a set of measure zero.
+        assert!(
+            report.no_sample <= 5,
+            "{name}: {} offsets on the rim",
+            report.no_sample
+        );
+        let mean = sum / n as f64;
+        let sd = ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
+        let expected = 1.0; // ∫f / ∫|f| for a non-negative filter
+        assert!(
+            (mean - expected).abs() <= 4.0 * sd + 1e-6,
+            "{name}: mean weight {mean} ± {sd}, expected {expected}"
+        );
+    }
+}
