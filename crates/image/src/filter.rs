@@ -270,87 +270,8 @@ mod tests {
     use super::*;
     use radiant_math::hash::Pcg32;
 
-    /// Chi-square test of sampled offsets against the normalised filter on a `bins`²
-    /// grid over the support. Expected bin probabilities come from an 8×8 midpoint rule
-    /// per bin (error far below the ~7% Poisson noise per bin at these counts).
-    fn chi_square(filter: &Filter, n: usize, bins: usize, seed: u64) -> (f64, usize) {
-        let r = filter.radius();
-        let mut counts = vec![0usize; bins * bins];
-        let mut rng = Pcg32::new(seed, 7);
-        for _ in 0..n {
-            let s = filter.sample(Vec2::new(rng.uniform(), rng.uniform()));
-            assert!(s.weight.is_finite() && s.weight > 0.0, "{s:?}");
-            assert!(s.offset.x.abs() <= r.x && s.offset.y.abs() <= r.y, "{s:?}");
-            let bx = (((s.offset.x + r.x) / (2.0 * r.x)) * bins as f32) as usize;
-            let by = (((s.offset.y + r.y) / (2.0 * r.y)) * bins as f32) as usize;
-            counts[by.min(bins - 1) * bins + bx.min(bins - 1)] += 1;
-        }
-        let (bw, bh) = (2.0 * r.x / bins as f32, 2.0 * r.y / bins as f32);
-        let sub = 8;
-        let mut expected = vec![0.0f64; bins * bins];
-        for by in 0..bins {
-            for bx in 0..bins {
-                let mut s = 0.0f64;
-                for j in 0..sub {
-                    for i in 0..sub {
-                        let x = -r.x + (bx as f32 + (i as f32 + 0.5) / sub as f32) * bw;
-                        let y = -r.y + (by as f32 + (j as f32 + 0.5) / sub as f32) * bh;
-                        s += filter.eval(Vec2::new(x, y)) as f64;
-                    }
-                }
-                expected[by * bins + bx] = s / (sub * sub) as f64 * (bw * bh) as f64;
-            }
-        }
-        let total: f64 = expected.iter().sum();
-        // The numerical integral must agree with the closed form / Simpson integral.
-        assert!(
-            (total / filter.integral() as f64 - 1.0).abs() < 1e-3,
-            "{total} vs {}",
-            filter.integral()
-        );
-        let mut chi2 = 0.0;
-        let mut dof = 0;
-        for (c, e) in counts.iter().zip(&expected) {
-            let e = e / total * n as f64;
-            if e > 5.0 {
-                chi2 += (*c as f64 - e).powi(2) / e;
-                dof += 1;
-            } else {
-                assert!(
-                    (*c as f64) < 5.0 * e.max(1.0) + 10.0,
-                    "{c} in a bin expecting {e}"
-                );
-            }
-        }
-        (chi2, dof.max(1) - 1)
-    }
-
-    /// Chi-square with k degrees of freedom has mean k and sd sqrt(2k); 5 sd above the
-    /// mean is a false-failure rate below 1e-6 (and the seeds are fixed anyway).
-    fn assert_chi_square_ok(filter: &Filter) {
-        let (chi2, dof) = chi_square(filter, 200_000, 24, 1234);
-        let limit = dof as f64 + 5.0 * (2.0 * dof as f64).sqrt();
-        assert!(
-            chi2 < limit,
-            "{filter:?}: chi2 {chi2:.1} with {dof} dof (limit {limit:.1})"
-        );
-    }
-
-    #[test]
-    fn box_histogram_matches() {
-        assert_chi_square_ok(&Filter::box_filter(Vec2::new(0.5, 1.0)));
-    }
-
-    #[test]
-    fn triangle_histogram_matches() {
-        assert_chi_square_ok(&Filter::triangle(Vec2::new(1.0, 2.0)));
-    }
-
-    #[test]
-    fn gaussian_histogram_matches() {
-        assert_chi_square_ok(&Filter::default());
-        assert_chi_square_ok(&Filter::gaussian(Vec2::new(2.0, 1.0), 0.8));
-    }
+    // Chi-square tests of the sampled offsets, with the shared harness, are in
+    // tests/filter_sampling.rs.
 
     #[test]
     fn box_half_pixel_stays_in_pixel() {

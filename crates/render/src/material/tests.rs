@@ -80,62 +80,8 @@ fn sampled_albedo_matches_and_conserves_energy() {
     }
 }
 
-/// Lambertian sampling follows its pdf: a chi-square test over a 10x20 (theta, phi) grid.
-#[test]
-fn diffuse_sampling_passes_chi_square() {
-    let m = Material::Diffuse { albedo: Rgb::WHITE };
-    let wo = Vec3::new(0.3, 0.2, 0.93).normalize();
-    let (nt, np) = (10usize, 20usize);
-    let n = 200_000;
-    let mut hist = vec![0f64; nt * np];
-    let mut rng = Pcg32::new(11, 0);
-    for _ in 0..n {
-        let s = m
-            .sample(
-                wo,
-                rng.uniform(),
-                Vec2::new(rng.uniform(), rng.uniform()),
-                TransportMode::Radiance,
-            )
-            .unwrap();
-        assert!((s.pdf - m.pdf(wo, s.wi)).abs() < 1e-4);
-        let theta = s.wi.z.clamp(-1.0, 1.0).acos();
-        let phi = s.wi.y.atan2(s.wi.x).rem_euclid(2.0 * std::f32::consts::PI);
-        let it = ((theta / (std::f32::consts::PI / 2.0)) * nt as f32).min(nt as f32 - 1.0) as usize;
-        let ip = ((phi / (2.0 * std::f32::consts::PI)) * np as f32).min(np as f32 - 1.0) as usize;
-        hist[it * np + ip] += 1.0;
-    }
-    // Expected counts: integrate the pdf over each cell numerically (midpoint rule, 8x8 per cell).
-    let mut chi2 = 0.0;
-    for it in 0..nt {
-        for ip in 0..np {
-            let mut p = 0.0f64;
-            let k = 8;
-            for a in 0..k {
-                for b in 0..k {
-                    let t = (it as f64 + (a as f64 + 0.5) / k as f64) * std::f64::consts::FRAC_PI_2
-                        / nt as f64;
-                    let ph = (ip as f64 + (b as f64 + 0.5) / k as f64) * 2.0 * std::f64::consts::PI
-                        / np as f64;
-                    let wi = Vec3::new(
-                        (t.sin() * ph.cos()) as f32,
-                        (t.sin() * ph.sin()) as f32,
-                        t.cos() as f32,
-                    );
-                    let dw = t.sin()
-                        * (std::f64::consts::FRAC_PI_2 / nt as f64)
-                        * (2.0 * std::f64::consts::PI / np as f64)
-                        / (k * k) as f64;
-                    p += m.pdf(wo, wi) as f64 * dw;
-                }
-            }
-            let e = p * n as f64;
-            chi2 += (hist[it * np + ip] - e).powi(2) / e;
-        }
-    }
-    // 199 degrees of freedom: mean 199, sd 20; 300 is beyond 5 sd.
-    assert!(chi2 < 300.0, "chi2 = {chi2}");
-}
+// Chi-square tests of the sampling routines, with the shared harness, are in
+// tests/bsdf_sampling.rs.
 
 #[test]
 fn dielectric_reflection_and_refraction_frequencies_follow_fresnel() {
