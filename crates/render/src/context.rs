@@ -15,7 +15,7 @@ use crate::camera::{self, Camera, CameraRay};
 use crate::sampler::PixelSample;
 use crate::world::World;
 use radiant_image::{Film, Filter, Sensor};
-use radiant_scene::{FilterKind, SamplerKind, SceneDesc, SceneError, Warning};
+use radiant_scene::{FileLoc, FilterKind, SamplerKind, SceneDesc, SceneError, Warning};
 
 /// Command-line overrides of the scene's settings.
 #[derive(Clone, Debug, Default)]
@@ -80,6 +80,20 @@ impl RenderContext {
             .unwrap_or((desc.film.xresolution, desc.film.yresolution));
         let (world, w) = World::build(desc)?;
         warnings.extend(w);
+        // Nothing to see or nothing to see by: the image will be black, which is worth a
+        // word before the render rather than a puzzle after it.
+        let scene_loc = FileLoc::new(desc.camera.loc.file.clone(), 0, 0);
+        if world.primitive_count() == 0 && world.lights.is_empty() {
+            warnings.push(Warning {
+                loc: scene_loc,
+                message: "the scene has no shapes and no lights: the image will be black".into(),
+            });
+        } else if world.lights.is_empty() {
+            warnings.push(Warning {
+                loc: scene_loc,
+                message: "the scene has no lights: the image will be black".into(),
+            });
+        }
         let camera = camera::from_desc(&desc.camera, &desc.film, resolution, &mut warnings)?;
         let filter = match desc.filter.kind {
             FilterKind::Box => Filter::box_filter(desc.filter.radius),
