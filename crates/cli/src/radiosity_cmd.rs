@@ -138,6 +138,10 @@ pub struct RadiosityArgs {
     /// No progress bar and no summary (the energy balance is still printed).
     #[arg(long)]
     pub quiet: bool,
+    /// Largest memory the solve may plan for (bytes, or with K, M, G, T: 16G); default
+    /// three quarters of the physical memory.
+    #[arg(long, value_parser = crate::render_cmd::parse_bytes, value_name = "BYTES")]
+    pub memory_limit: Option<u64>,
 }
 
 impl RadiosityArgs {
@@ -241,6 +245,9 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
     }
     check_outputs(&args)?;
     let threads = capped_threads(args.threads);
+    if let Some(bytes) = args.memory_limit {
+        radiant::render::budget::set_limit(bytes);
+    }
     let mut desc = load_scene(args.scene.as_deref())?;
     for w in &desc.warnings {
         eprintln!("{w}");

@@ -50,6 +50,32 @@ pub struct RenderArgs {
     /// No progress bar and no summary.
     #[arg(long)]
     pub quiet: bool,
+    /// Largest memory the render may plan for (bytes, or with K, M, G, T: 16G); default
+    /// three quarters of the physical memory.
+    #[arg(long, value_parser = parse_bytes, value_name = "BYTES")]
+    pub memory_limit: Option<u64>,
+}
+
+/// `16G`, `512M`, `1.5e9`: a number of bytes with an optional binary unit suffix.
+pub fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (number, scale) = match t.char_indices().last() {
+        Some((i, c)) if c.is_ascii_alphabetic() => {
+            let scale = match c.to_ascii_uppercase() {
+                'K' => 1u64 << 10,
+                'M' => 1 << 20,
+                'G' => 1 << 30,
+                'T' => 1 << 40,
+                _ => return Err(format!("unknown unit '{c}' in \"{s}\" (use K, M, G or T)")),
+            };
+            (&t[..i], scale)
+        }
+        _ => (t, 1),
+    };
+    match number.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 1.0 => Ok((v * scale as f64).min(u64::MAX as f64) as u64),
+        _ => Err(format!("expected a positive number of bytes, got \"{s}\"")),
+    }
 }
 
 /// A finite number of stops (NaN or infinity would make every pixel black or white).
@@ -106,6 +132,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         check_output(output)?;
     }
     let threads = capped_threads(args.threads);
+    if let Some(bytes) = args.memory_limit {
+        radiant::render::budget::set_limit(bytes);
+    }
     let desc = load_scene(args.scene.as_deref())?;
     for w in &desc.warnings {
         eprintln!("{w}");

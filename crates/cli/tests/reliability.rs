@@ -372,7 +372,14 @@ fn a_photon_pass_cut_short_writes_no_black_image() {
     let child = radiant()
         .arg("render")
         .arg(&scene)
-        .args(["--resolution", "16x16", "--quiet", "-o"])
+        .args([
+            "--resolution",
+            "16x16",
+            "--memory-limit",
+            "64G",
+            "--quiet",
+            "-o",
+        ])
         .arg(&path)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -518,4 +525,72 @@ fn scene_inputs_have_limits_and_dark_scenes_a_warning() {
     let stderr = stderr_of(&out);
     assert!(out.status.success(), "{stderr}");
     assert!(!stderr.contains("warning"), "{stderr}");
+}
+
+/// Requests far beyond the memory budget stop with a located error naming the parameter
+/// and the estimate, before allocating: run under a 4 GB address-space limit, any
+/// attempt would abort the process instead ("memory allocation failed", status 134).
+#[test]
+fn oversized_requests_fail_with_a_located_estimate() {
+    let dir = temp_dir("oversized");
+    let photons = write_scene(
+        &dir,
+        "photons.pbrt",
+        &format!(
+            "Integrator \"photonmap\"\n  \"integer photons\" [ 2000000000 ]\n{CAMERA}WorldBegin\n\
+             LightSource \"point\" \"point3 from\" [0 0 5]\nShape \"sphere\"\n"
+        ),
+    );
+    let photons = photons.to_str().unwrap();
+    let out = dir.join("out.exr");
+    let out = out.to_str().unwrap();
+    let cases: [(&[&str], &str); 5] = [
+        (
+            &["render", "--resolution", "100000x100000"],
+            "--resolution: error: a 100000x100000 film would need ≈",
+        ),
+        (
+            &["radiosity", "--max-patch-area", "1e-12"],
+            "--max-patch-area: error: maxpatcharea 1.00e-12 would make",
+        ),
+        (
+            &["radiosity", "--subdivision", "4096"],
+            "--subdivision: error: subdivision 4096 on",
+        ),
+        (
+            &[
+                "radiosity",
+                "--solver",
+                "gaussseidel",
+                "--max-patch-area",
+                "17",
+            ],
+            "dense form-factor matrix",
+        ),
+        (
+            &["render", photons],
+            "photons.pbrt:2:3: error: 2000000000 photons",
+        ),
+    ];
+    for (args, expect) in cases {
+        let mut all: Vec<&str> = args.to_vec();
+        all.extend(["--memory-limit", "2G", "-o", out]);
+        let mut script = String::from("ulimit -v 4000000; exec \"$0\"");
+        for i in 0..all.len() {
+            script.push_str(&format!(" \"${}\"", i + 1));
+        }
+        let result = Command::new("sh")
+            .arg("-c")
+            .arg(script)
+            .arg(BIN)
+            .args(&all)
+            .output()
+            .unwrap();
+        let stderr = assert_clean_failure(&result, expect);
+        assert!(stderr.contains(expect), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("the memory limit is 2.1 GB"),
+            "{args:?}: {stderr}"
+        );
+    }
 }

@@ -78,6 +78,22 @@ impl RenderContext {
         let resolution = overrides
             .resolution
             .unwrap_or((desc.film.xresolution, desc.film.yresolution));
+        // The film (and the image made from it) before anything else is built.
+        let pixels = resolution.0 as f64 * resolution.1 as f64;
+        let bytes = pixels
+            * (std::mem::size_of::<radiant_image::FilmPixel>()
+                + std::mem::size_of::<radiant_math::color::Rgb>()) as f64;
+        if let Err(over) = crate::budget::check(bytes) {
+            let loc = if overrides.resolution.is_some() {
+                FileLoc::new("--resolution", 0, 0)
+            } else {
+                desc.film.loc.clone()
+            };
+            return Err(SceneError::at(
+                &loc,
+                format!("a {}x{} film would need {over}", resolution.0, resolution.1),
+            ));
+        }
         let (world, w) = World::build(desc)?;
         warnings.extend(w);
         // Nothing to see or nothing to see by: the image will be black, which is worth a
