@@ -88,7 +88,7 @@ pub fn run(args: LensArgs) -> anyhow::Result<()> {
         );
     }
     if let Some(path) = &args.svg {
-        std::fs::write(path, lens_svg(&camera))
+        radiant::image::atomic::atomic_write_bytes(path, lens_svg(&camera).as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
         println!("cross-section written to {}", path.display());
     }

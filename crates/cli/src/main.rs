@@ -5,6 +5,7 @@ mod compare_cmd;
 mod lens_cmd;
 mod radiosity_cmd;
 mod render_cmd;
+mod signals;
 
 use clap::{Parser, Subcommand};
 

@@ -20,7 +20,47 @@ use radiant::render::integrator::render_passes;
 use radiant::render::{Overrides, Progress, RenderContext, RenderControl};
 use radiant::scene::{FileLoc, Param, ParamValue};
 
-use crate::render_cmd::{draw_progress, interruptible_progress, load_scene, worker_pool};
+use crate::render_cmd::{capped_threads, check_output, draw_progress, load_scene, worker_pool};
+use crate::signals::Interrupts;
+
+fn parse_positive(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(0) => Err("must be at least 1".into()),
+        Ok(n) => Ok(n),
+        Err(_) => Err(format!("expected a positive whole number, got \"{s}\"")),
+    }
+}
+
+/// Refuses, before any work, output paths that cannot be written: an unknown mesh
+/// format, a missing or read-only folder.
+fn check_outputs(args: &RadiosityArgs) -> anyhow::Result<()> {
+    use radiant::image::atomic::check_writable;
+    if let Some(path) = &args.output {
+        check_output(path)?;
+    }
+    if let Some(pattern) = &args.sequence {
+        check_output(&frame_path(pattern, 1))?;
+    }
+    if let Some(path) = &args.export {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        if !matches!(ext.as_deref(), Some("gltf" | "glb" | "ply")) {
+            bail!(
+                "--export {}: unknown mesh format (use .gltf, .glb or .ply)",
+                path.display()
+            );
+        }
+        check_writable(path)
+            .with_context(|| format!("cannot write the mesh {}", path.display()))?;
+    }
+    if let Some(path) = &args.patches {
+        check_writable(path)
+            .with_context(|| format!("cannot write the patch table {}", path.display()))?;
+    }
+    Ok(())
+}
 
 #[derive(Args, Debug)]
 pub struct RadiosityArgs {
@@ -36,7 +76,7 @@ pub struct RadiosityArgs {
     #[arg(long)]
     pub patches: Option<PathBuf>,
     /// With --sequence: write an image every K progressive shots.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", value_parser = parse_positive)]
     pub every: Option<usize>,
     /// Image sequence name; the run of '#' becomes the frame number (out-####.png).
     #[arg(long)]
@@ -84,7 +124,7 @@ pub struct RadiosityArgs {
     #[arg(long, value_name = "LEVELS")]
     pub contact_grading: Option<u32>,
     /// Samples per pixel of the images.
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: Option<u32>,
     /// Image size as WIDTHxHEIGHT, overriding the film's.
     #[arg(long, value_parser = crate::render_cmd::parse_resolution)]
@@ -93,59 +133,82 @@ pub struct RadiosityArgs {
     #[arg(long, alias = "nthreads")]
     pub threads: Option<usize>,
     /// Exposure in stops for PNG output.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = crate::render_cmd::parse_exposure, allow_hyphen_values = true)]
     pub exposure: f32,
     /// No progress bar and no summary (the energy balance is still printed).
     #[arg(long)]
     pub quiet: bool,
+    /// Largest memory the solve may plan for (bytes, or with K, M, G, T: 16G); default
+    /// three quarters of the physical memory.
+    #[arg(long, value_parser = crate::render_cmd::parse_bytes, value_name = "BYTES")]
+    pub memory_limit: Option<u64>,
 }
 
 impl RadiosityArgs {
     /// The command-line settings as `Integrator "radiosity"` parameters, so they are
     /// checked and documented in one place.
     fn params(&self) -> Vec<Param> {
-        let loc = FileLoc::new("<command line>", 0, 0);
         let mut out = Vec::new();
-        let mut push =
-            |name: &str, value: ParamValue| out.push(Param::new(name, value, loc.clone()));
+        // Each parameter is located at its flag, so a bad value is reported as
+        // "--max-patch-area: error: ...".
+        let mut push = |flag: &str, name: &str, value: ParamValue| {
+            out.push(Param::new(name, value, FileLoc::new(flag, 0, 0)))
+        };
+        let int = |v: u32| ParamValue::Int(vec![i32::try_from(v).unwrap_or(i32::MAX)]);
         if let Some(v) = self.max_patch_area {
-            push("maxpatcharea", ParamValue::Float(vec![v]));
+            push(
+                "--max-patch-area",
+                "maxpatcharea",
+                ParamValue::Float(vec![v]),
+            );
         }
         if let Some(v) = self.subdivision {
-            push("subdivision", ParamValue::Int(vec![v as i32]));
+            push("--subdivision", "subdivision", int(v));
         }
         if let Some(v) = &self.formfactor {
-            push("formfactor", ParamValue::String(vec![v.clone()]));
+            push(
+                "--formfactor",
+                "formfactor",
+                ParamValue::String(vec![v.clone()]),
+            );
         }
         if let Some(v) = self.hemicube_res {
-            push("hemicuberes", ParamValue::Int(vec![v as i32]));
+            push("--hemicube-res", "hemicuberes", int(v));
         }
         if let Some(v) = &self.solver {
-            push("solver", ParamValue::String(vec![v.clone()]));
+            push("--solver", "solver", ParamValue::String(vec![v.clone()]));
         }
         if let Some(v) = self.tolerance {
-            push("tolerance", ParamValue::Float(vec![v]));
+            push("--tolerance", "tolerance", ParamValue::Float(vec![v]));
         }
         if let Some(v) = self.max_iterations {
-            push("maxiterations", ParamValue::Int(vec![v as i32]));
+            push("--max-iterations", "maxiterations", int(v));
         }
         if let Some(v) = self.final_gather {
-            push("finalgather", ParamValue::Int(vec![v as i32]));
+            push("--final-gather", "finalgather", int(v));
         }
         if let Some(v) = &self.visibility {
-            push("visibility", ParamValue::String(vec![v.clone()]));
+            push(
+                "--visibility",
+                "visibility",
+                ParamValue::String(vec![v.clone()]),
+            );
         }
         if self.two_sided {
-            push("twosided", ParamValue::Bool(vec![true]));
+            push("--two-sided", "twosided", ParamValue::Bool(vec![true]));
         }
         if let Some(v) = self.refine {
-            push("refine", ParamValue::Int(vec![v as i32]));
+            push("--refine", "refine", int(v));
         }
         if let Some(v) = self.refine_threshold {
-            push("refinethreshold", ParamValue::Float(vec![v]));
+            push(
+                "--refine-threshold",
+                "refinethreshold",
+                ParamValue::Float(vec![v]),
+            );
         }
         if let Some(v) = self.contact_grading {
-            push("contactgrading", ParamValue::Int(vec![v as i32]));
+            push("--contact-grading", "contactgrading", int(v));
         }
         out
     }
@@ -177,6 +240,14 @@ fn frame_path(pattern: &Path, frame: usize) -> PathBuf {
 }
 
 pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
+    if args.sequence.is_some() != args.every.is_some() {
+        bail!("--every K and --sequence NAME go together");
+    }
+    check_outputs(&args)?;
+    let threads = capped_threads(args.threads);
+    if let Some(bytes) = args.memory_limit {
+        radiant::render::budget::set_limit(bytes);
+    }
     let mut desc = load_scene(args.scene.as_deref())?;
     for w in &desc.warnings {
         eprintln!("{w}");
@@ -188,9 +259,6 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
     }
     for p in args.params() {
         desc.integrator.params.push(p);
-    }
-    if args.sequence.is_some() != args.every.is_some() {
-        bail!("--every K and --sequence NAME go together");
     }
     let overrides = Overrides {
         spp: args.spp,
@@ -220,8 +288,9 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
             &mut RenderControl::new(progress, &mut |_, _| {}),
         )
     };
-    let progress = interruptible_progress()?;
-    let pool = worker_pool(args.threads)?;
+    let interrupts = Interrupts::install()?;
+    let progress = Arc::clone(&interrupts.progress);
+    let pool = worker_pool(threads)?;
     let show_bar = !args.quiet && std::io::stderr().is_terminal();
     let meta = |spp: u32, seconds: f64| ImageMeta {
         samples_per_pixel: Some(spp),
@@ -265,6 +334,7 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
                         .with_specular_depth(settings.max_depth);
                     let out = render_shading(&shading, &Progress::default());
                     let path = frame_path(pattern, state.shots / every);
+                    let _writing = interrupts.writing();
                     if let Err(e) = write_image(
                         &path,
                         &out.film.image(),
@@ -310,6 +380,19 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         );
     }
     println!("{}", solution.balance.summary());
+    // A solve cut short is not the solution: writing it would replace good exports and
+    // images with ones that look finished.
+    if solution.interrupted {
+        let frames = if args.sequence.is_some() {
+            "; the sequence frames written so far are complete"
+        } else {
+            ""
+        };
+        bail!(
+            "interrupted during the solve after {} iterations: no mesh, table or image written{frames}",
+            solution.iterations
+        );
+    }
 
     let display = solution.display_radiosity(&scene.patches);
     let shading = Shading::new(
@@ -322,6 +405,7 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
     .with_specular_depth(settings.max_depth);
     if let Some(path) = &args.export {
         let mesh = LitMesh::new(scene, shading.mesh(), shading.vertex_radiosity());
+        let _writing = interrupts.writing();
         let is_ply = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("ply"));
@@ -340,6 +424,7 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         }
     }
     if let Some(path) = &args.patches {
+        let _writing = interrupts.writing();
         write_patch_csv(path, scene, solution)?;
     }
     let wrote_something =
@@ -349,11 +434,17 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         (None, false) => Some(PathBuf::from(desc.output_name())),
         (None, true) => None,
     };
-    if let Some(path) = output
-        && !solution.interrupted
-    {
+    let mut written = None;
+    if let Some(path) = output {
         progress.done.store(0, Ordering::Relaxed);
         let out = pool.install(|| render_shading(&shading, &progress));
+        if out.interrupted && out.spp_done == 0 {
+            bail!(
+                "interrupted before every pixel had a sample: no image written ({} left as it was)",
+                path.display()
+            );
+        }
+        let _writing = interrupts.writing();
         write_image(
             &path,
             &out.film.image(),
@@ -372,12 +463,16 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
                 out.seconds
             );
         }
+        written = Some((path, out.spp_done));
     }
-    if solution.interrupted {
-        bail!(
-            "interrupted during the solve after {} iterations",
-            solution.iterations
-        );
+    if progress.cancelled() {
+        match written {
+            Some((path, spp)) => bail!(
+                "interrupted: wrote the solution and the image so far ({spp} spp) to {}",
+                path.display()
+            ),
+            None => bail!("interrupted after the solve: wrote the solution"),
+        }
     }
     Ok(())
 }

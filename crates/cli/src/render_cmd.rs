@@ -10,6 +10,8 @@ use anyhow::{Context, bail};
 use clap::Args;
 use radiant::image::{ImageMeta, write_image};
 use radiant::render::{Overrides, Progress};
+
+use crate::signals::Interrupts;
 use radiant::scene::{
     SceneDesc,
     builtin::{BUILTIN_SCENES, builtin_scene},
@@ -21,7 +23,7 @@ pub struct RenderArgs {
     /// A pbrt-v4 scene file, or a canonical scene: cornell-box (default), cornell-caustics, furnace.
     pub scene: Option<String>,
     /// Samples per pixel (overrides the scene's Sampler "pixelsamples").
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: Option<u32>,
     /// Seed of the sampler (overrides the scene's).
     #[arg(long)]
@@ -43,11 +45,46 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_resolution)]
     pub resolution: Option<(u32, u32)>,
     /// Exposure in stops for PNG output.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = parse_exposure, allow_hyphen_values = true)]
     pub exposure: f32,
     /// No progress bar and no summary.
     #[arg(long)]
     pub quiet: bool,
+    /// Largest memory the render may plan for (bytes, or with K, M, G, T: 16G); default
+    /// three quarters of the physical memory.
+    #[arg(long, value_parser = parse_bytes, value_name = "BYTES")]
+    pub memory_limit: Option<u64>,
+}
+
+/// `16G`, `512M`, `1.5e9`: a number of bytes with an optional binary unit suffix.
+pub fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (number, scale) = match t.char_indices().last() {
+        Some((i, c)) if c.is_ascii_alphabetic() => {
+            let scale = match c.to_ascii_uppercase() {
+                'K' => 1u64 << 10,
+                'M' => 1 << 20,
+                'G' => 1 << 30,
+                'T' => 1 << 40,
+                _ => return Err(format!("unknown unit '{c}' in \"{s}\" (use K, M, G or T)")),
+            };
+            (&t[..i], scale)
+        }
+        _ => (t, 1),
+    };
+    match number.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 1.0 => Ok((v * scale as f64).min(u64::MAX as f64) as u64),
+        _ => Err(format!("expected a positive number of bytes, got \"{s}\"")),
+    }
+}
+
+/// A finite number of stops (NaN or infinity would make every pixel black or white).
+pub fn parse_exposure(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(v) => Err(format!("must be a finite number of stops, got {v}")),
+        Err(_) => Err(format!("expected a number of stops, got \"{s}\"")),
+    }
 }
 
 pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -90,9 +127,24 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             INTEGRATOR_NAMES.join(", ")
         );
     }
+    // A path the image cannot be written to is refused before any work.
+    if let Some(output) = &args.output {
+        check_output(output)?;
+    }
+    let threads = capped_threads(args.threads);
+    if let Some(bytes) = args.memory_limit {
+        radiant::render::budget::set_limit(bytes);
+    }
     let desc = load_scene(args.scene.as_deref())?;
     for w in &desc.warnings {
         eprintln!("{w}");
+    }
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(desc.output_name()));
+    if args.output.is_none() {
+        check_output(&output)?;
     }
     let overrides = Overrides {
         spp: args.spp,
@@ -104,13 +156,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     for w in &session.warnings {
         eprintln!("{w}");
     }
-    let output = args
-        .output
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(desc.output_name()));
 
-    let progress = interruptible_progress()?;
-    let pool = worker_pool(args.threads)?;
+    let interrupts = Interrupts::install()?;
+    let progress = Arc::clone(&interrupts.progress);
+    let pool = worker_pool(threads)?;
     let show_bar = !args.quiet && std::io::stderr().is_terminal();
     let output_data = std::thread::scope(|scope| {
         let bar_done = Arc::new(std::sync::atomic::AtomicBool::new(false));
@@ -130,6 +179,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
                 render_time_seconds: None,
                 software: format!("radiant {}", env!("CARGO_PKG_VERSION")),
             };
+            let _writing = interrupts.writing();
             if let Err(e) = write_image(&path, &film.image(), &meta, args.exposure) {
                 snapshot_errors.push(format!("writing {}: {e}", path.display()));
             }
@@ -142,13 +192,24 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         out
     });
 
+    // Stopped before every pixel had a sample (photon tracing, radiosity solve, the first
+    // pass): such an image would pass for a black render, so the previous file stays.
+    if output_data.interrupted && output_data.spp_done == 0 {
+        bail!(
+            "interrupted before every pixel had a sample: no image written ({} left as it was)",
+            output.display()
+        );
+    }
     let meta = ImageMeta {
         samples_per_pixel: Some(output_data.spp_done),
         render_time_seconds: Some(output_data.seconds),
         software: format!("radiant {}", env!("CARGO_PKG_VERSION")),
     };
-    write_image(&output, &output_data.film.image(), &meta, args.exposure)
-        .with_context(|| format!("writing {}", output.display()))?;
+    {
+        let _writing = interrupts.writing();
+        write_image(&output, &output_data.film.image(), &meta, args.exposure)
+            .with_context(|| format!("writing {}", output.display()))?;
+    }
     let nf = output_data.film.nonfinite;
     if nf.count > 0 {
         let (x, y) = nf.first_pixel.unwrap_or((0, 0));
@@ -183,6 +244,33 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Checks that `path` names an image format and that its folder takes a new file.
+pub fn check_output(path: &Path) -> anyhow::Result<()> {
+    radiant::image::check_output(path)
+        .map(|_| ())
+        .with_context(|| format!("cannot write the output image {}", path.display()))
+}
+
+/// More worker threads than this many per core only add scheduling overhead.
+const THREADS_PER_CORE: usize = 4;
+
+/// `--threads`, capped at a few per core (with a warning): tens of thousands of threads
+/// exhaust memory and the scheduler long before the render starts.
+pub fn capped_threads(threads: Option<usize>) -> Option<usize> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let cap = THREADS_PER_CORE * cores;
+    match threads {
+        Some(n) if n > cap => {
+            eprintln!(
+                "warning: --threads {n}: using {cap} ({THREADS_PER_CORE} per core, {cores} cores)"
+            );
+            Some(cap)
+        }
+        // 0 asks for the default, as rayon reads it: all cores.
+        other => other,
+    }
+}
+
 /// `out.exr` → `out-00016.exr`.
 fn snapshot_path(output: &Path, n: u32) -> PathBuf {
     let stem = output
@@ -193,20 +281,6 @@ fn snapshot_path(output: &Path, n: u32) -> PathBuf {
         None => format!("{stem}-{n:05}"),
     };
     output.with_file_name(name)
-}
-
-/// Progress counters whose `cancel` flag Ctrl-C sets; the render then stops and the
-/// image so far is written. A second Ctrl-C (while that image is written) exits at once.
-pub fn interruptible_progress() -> anyhow::Result<Arc<Progress>> {
-    let progress = Arc::new(Progress::default());
-    let flag = Arc::clone(&progress);
-    ctrlc::set_handler(move || {
-        if flag.cancel.swap(true, Ordering::SeqCst) {
-            std::process::exit(130);
-        }
-    })
-    .context("installing the Ctrl-C handler")?;
-    Ok(progress)
 }
 
 /// The rayon pool for `--threads` (all cores when `None`).

@@ -88,13 +88,19 @@ pub fn write_exr(
             .other
             .insert(Text::from(ATTR_RENDER_TIME), AttributeValue::F32(t as f32));
     }
-    exr_image
-        .write()
-        .to_file(path)
-        .map_err(|error| ImageError::Exr {
-            path: path.to_path_buf(),
-            error,
-        })
+    super::write_atomically(path, |file| {
+        exr_image
+            .write()
+            .to_buffered(file)
+            .map_err(|error| match error {
+                // The operating system's reason (disk full, permission) as it stands.
+                ::exr::error::Error::Io(e) => ImageError::io(path, e),
+                error => ImageError::Exr {
+                    path: path.to_path_buf(),
+                    error,
+                },
+            })
+    })
 }
 
 /// Reads the first layer of an EXR that has R, G and B channels (bare or as `<layer>.R`,

@@ -3,6 +3,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod atomic;
 pub mod error;
 pub mod exr;
 pub mod falsecolor;
@@ -225,6 +226,26 @@ pub fn write_image(
         Format::Pfm => pfm::write_pfm(path, image),
         Format::Png => png::write_png(path, image, exposure_stops),
     }
+}
+
+/// Writes `path` all or nothing through [`atomic::AtomicFile`]: `write` fills a temporary
+/// file beside it, which replaces `path` only once complete and synced.
+pub(crate) fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> Result<(), ImageError>,
+) -> Result<(), ImageError> {
+    let mut file = atomic::AtomicFile::create(path).map_err(|e| ImageError::io(path, e))?;
+    write(file.writer())?;
+    file.commit().map_err(|e| ImageError::io(path, e))
+}
+
+/// Checks before rendering that `path` names a known image format and can be created
+/// (its folder exists and is writable); returns the format.
+pub fn check_output(path: impl AsRef<Path>) -> Result<Format, ImageError> {
+    let path = path.as_ref();
+    let format = Format::from_path(path)?;
+    atomic::check_writable(path).map_err(|e| ImageError::io(path, e))?;
+    Ok(format)
 }
 
 /// Reads an image in the format named by the extension of `path`, as linear RGB.

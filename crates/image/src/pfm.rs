@@ -15,7 +15,10 @@ use radiant_math::color::Rgb;
 pub fn write_pfm(path: impl AsRef<Path>, image: &Image) -> Result<(), ImageError> {
     let path = path.as_ref();
     image.validate(path)?;
-    std::fs::write(path, encode_pfm(image)).map_err(|e| ImageError::io(path, e))
+    let bytes = encode_pfm(image);
+    super::write_atomically(path, |w| {
+        std::io::Write::write_all(w, &bytes).map_err(|e| ImageError::io(path, e))
+    })
 }
 
 /// The bytes of the little-endian RGB PFM file for `image`.

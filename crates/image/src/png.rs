@@ -62,9 +62,13 @@ pub fn write_png(
 ) -> Result<(), ImageError> {
     let path = path.as_ref();
     image.validate(path)?;
-    let png_error = |e: ::png::EncodingError| ImageError::Png {
-        path: path.to_path_buf(),
-        message: e.to_string(),
+    let png_error = |e: ::png::EncodingError| match e {
+        // The operating system's reason (disk full, permission) as it stands.
+        ::png::EncodingError::IoError(e) => ImageError::io(path, e),
+        e => ImageError::Png {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        },
     };
     let (w, h) = match (u32::try_from(image.width), u32::try_from(image.height)) {
         (Ok(w), Ok(h)) => (w, h),
@@ -75,16 +79,16 @@ pub fn write_png(
             });
         }
     };
-    let file = std::fs::File::create(path).map_err(|e| ImageError::io(path, e))?;
-    let mut encoder = ::png::Encoder::new(BufWriter::new(file), w, h);
-    encoder.set_color(::png::ColorType::Rgb);
-    encoder.set_depth(::png::BitDepth::Eight);
-    encoder.set_source_srgb(::png::SrgbRenderingIntent::Perceptual);
-    let mut writer = encoder.write_header().map_err(png_error)?;
-    writer
-        .write_image_data(&to_srgb8(image, exposure_stops))
-        .map_err(png_error)?;
-    writer.finish().map_err(png_error)
+    let bytes = to_srgb8(image, exposure_stops);
+    super::write_atomically(path, |file: &mut BufWriter<std::fs::File>| {
+        let mut encoder = ::png::Encoder::new(file, w, h);
+        encoder.set_color(::png::ColorType::Rgb);
+        encoder.set_depth(::png::BitDepth::Eight);
+        encoder.set_source_srgb(::png::SrgbRenderingIntent::Perceptual);
+        let mut writer = encoder.write_header().map_err(png_error)?;
+        writer.write_image_data(&bytes).map_err(png_error)?;
+        writer.finish().map_err(png_error)
+    })
 }
 
 /// Reads a PNG (any colour type, 8 or 16 bit) as linear RGB, assuming sRGB encoding.

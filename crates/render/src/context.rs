@@ -15,7 +15,7 @@ use crate::camera::{self, Camera, CameraRay};
 use crate::sampler::PixelSample;
 use crate::world::World;
 use radiant_image::{Film, Filter, Sensor};
-use radiant_scene::{FilterKind, SamplerKind, SceneDesc, SceneError, Warning};
+use radiant_scene::{FileLoc, FilterKind, SamplerKind, SceneDesc, SceneError, Warning};
 
 /// Command-line overrides of the scene's settings.
 #[derive(Clone, Debug, Default)]
@@ -78,8 +78,38 @@ impl RenderContext {
         let resolution = overrides
             .resolution
             .unwrap_or((desc.film.xresolution, desc.film.yresolution));
+        // The film (and the image made from it) before anything else is built.
+        let pixels = resolution.0 as f64 * resolution.1 as f64;
+        let bytes = pixels
+            * (std::mem::size_of::<radiant_image::FilmPixel>()
+                + std::mem::size_of::<radiant_math::color::Rgb>()) as f64;
+        if let Err(over) = crate::budget::check(bytes) {
+            let loc = if overrides.resolution.is_some() {
+                FileLoc::new("--resolution", 0, 0)
+            } else {
+                desc.film.loc.clone()
+            };
+            return Err(SceneError::at(
+                &loc,
+                format!("a {}x{} film would need {over}", resolution.0, resolution.1),
+            ));
+        }
         let (world, w) = World::build(desc)?;
         warnings.extend(w);
+        // Nothing to see or nothing to see by: the image will be black, which is worth a
+        // word before the render rather than a puzzle after it.
+        let scene_loc = FileLoc::new(desc.camera.loc.file.clone(), 0, 0);
+        if world.primitive_count() == 0 && world.lights.is_empty() {
+            warnings.push(Warning {
+                loc: scene_loc,
+                message: "the scene has no shapes and no lights: the image will be black".into(),
+            });
+        } else if world.lights.is_empty() {
+            warnings.push(Warning {
+                loc: scene_loc,
+                message: "the scene has no lights: the image will be black".into(),
+            });
+        }
         let camera = camera::from_desc(&desc.camera, &desc.film, resolution, &mut warnings)?;
         let filter = match desc.filter.kind {
             FilterKind::Box => Filter::box_filter(desc.filter.radius),

@@ -5,6 +5,7 @@
 
 pub mod accel;
 pub mod bench;
+pub mod budget;
 pub mod camera;
 pub mod context;
 pub mod geometry;

@@ -29,7 +29,13 @@ impl FileLoc {
 
 impl fmt::Display for FileLoc {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}:{}", self.file, self.line, self.column)
+        // Line 0 marks a place that is not in a file (a built-in scene, a command-line
+        // flag): its name alone, not a made-up position.
+        if self.line == 0 {
+            write!(f, "{}", self.file)
+        } else {
+            write!(f, "{}:{}:{}", self.file, self.line, self.column)
+        }
     }
 }
 

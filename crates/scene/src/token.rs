@@ -27,8 +27,8 @@ impl TokenKind {
     /// A short description for error messages.
     pub fn describe(&self) -> String {
         match self {
-            TokenKind::Word(w) => format!("'{w}'"),
-            TokenKind::Str(s) => format!("string \"{s}\""),
+            TokenKind::Word(w) => format!("'{}'", excerpt(w)),
+            TokenKind::Str(s) => format!("string \"{}\"", excerpt(s)),
             TokenKind::Num { value, .. } => format!("number {value}"),
             TokenKind::Open => "'['".into(),
             TokenKind::Close => "']'".into(),
@@ -51,6 +51,20 @@ pub struct Lexer {
     pos: usize,
     line: u32,
     column: u32,
+}
+
+/// The longest token (word, number or string) read, in bytes: file names and names of
+/// things are far shorter; a longer one is a broken file (a missing quote, binary data).
+pub const MAX_TOKEN_BYTES: usize = 64 * 1024;
+
+/// At most the first 80 characters of `text` for a message, with the length when cut.
+pub fn excerpt(text: &str) -> String {
+    const SHOWN: usize = 80;
+    if text.chars().count() <= SHOWN {
+        return text.to_string();
+    }
+    let head: String = text.chars().take(SHOWN - 1).collect();
+    format!("{head}… ({} bytes)", text.len())
 }
 
 fn ends_word(b: u8) -> bool {
@@ -149,6 +163,7 @@ impl Lexer {
                     self.bump();
                 }
                 let word = &self.text[start..self.pos];
+                check_length(word, &loc)?;
                 number_or_word(word, &loc)?
             }
         };
@@ -168,6 +183,7 @@ impl Lexer {
                 self.bump();
             }
             out.push_str(&self.text[start..self.pos]);
+            check_length(&out, open)?;
             match self.peek_byte() {
                 Some(b'"') => {
                     self.bump();
@@ -206,6 +222,20 @@ impl Lexer {
     }
 }
 
+fn check_length(token: &str, loc: &FileLoc) -> Result<(), SceneError> {
+    if token.len() > MAX_TOKEN_BYTES {
+        return Err(SceneError::at(
+            loc,
+            format!(
+                "token longer than {} KiB: '{}'",
+                MAX_TOKEN_BYTES / 1024,
+                excerpt(token)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 fn number_or_word(word: &str, loc: &FileLoc) -> Result<TokenKind, SceneError> {
     let first = word.as_bytes()[0];
     let numeric = first.is_ascii_digit() || matches!(first, b'+' | b'-' | b'.');
@@ -214,13 +244,12 @@ fn number_or_word(word: &str, loc: &FileLoc) -> Result<TokenKind, SceneError> {
     }
     let value: f64 = word
         .parse()
-        .map_err(|_| SceneError::at(loc, format!("bad number '{word}'")))?;
+        .map_err(|_| SceneError::at(loc, format!("bad number '{}'", excerpt(word))))?;
     let digits = word.strip_prefix(['+', '-']).unwrap_or(word);
     let integer = if !digits.is_empty() && digits.bytes().all(|c| c.is_ascii_digit()) {
-        Some(
-            word.parse::<i64>()
-                .map_err(|_| SceneError::at(loc, format!("integer '{word}' is too large")))?,
-        )
+        Some(word.parse::<i64>().map_err(|_| {
+            SceneError::at(loc, format!("integer '{}' is too large", excerpt(word)))
+        })?)
     } else {
         None
     };

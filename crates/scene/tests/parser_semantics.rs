@@ -46,7 +46,7 @@ fn absent_directives_take_pbrt_v4_defaults() {
     );
     assert_eq!(s.filter.kind, FilterKind::Gaussian { sigma: 0.5 });
     assert_eq!(s.filter.radius, Vec2::splat(1.5));
-    assert_eq!(s.integrator.name, "volpath");
+    assert_eq!(s.integrator.name, "path");
     assert_eq!(s.integrator.params.int("maxdepth", 0).unwrap(), 5);
     assert!(s.warnings.is_empty());
 }

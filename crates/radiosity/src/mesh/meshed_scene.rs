@@ -12,7 +12,7 @@ use glam::{DMat4, DVec3, Vec3};
 
 use super::face_mesh::{FaceMesh, Subdivision};
 use super::patch::PatchSet;
-use crate::settings::{DEFAULT_PATCH_COUNT, RadiositySettings};
+use crate::settings::{DEFAULT_PATCH_COUNT, RadiositySettings, SolverKind};
 use radiant_scene::{
     Geometry, LightDesc, MaterialDesc, SceneDesc, SceneError, ShapeDesc, Warning, sphere_z_range,
 };
@@ -131,12 +131,41 @@ impl RadiosityScene {
             .unwrap_or(total_area / DEFAULT_PATCH_COUNT)
             .max(1e-30);
         let max_edge = max_area.sqrt();
+        // Before meshing: the patch count the area asks for. The shapes' own
+        // tessellation and the subdivision follow this edge length, so a request beyond
+        // the budget is refused here, before either allocates.
+        let param_loc = |name: &str| {
+            desc.integrator
+                .params
+                .lookup(name)
+                .map_or(&desc.integrator.loc, |p| &p.loc)
+                .clone()
+        };
+        let patches_by_area = total_area / max_area;
+        check_patch_budget(
+            patches_by_area,
+            settings,
+            &param_loc("maxpatcharea"),
+            &format!("maxpatcharea {max_area:.2e}"),
+        )?;
 
         let mut faces = FaceMesh::new();
         for ((shape, xf), tag) in shapes.iter().zip(&shape_tags) {
             let Some(tag) = *tag else { continue };
             add_shape(&mut faces, shape, xf, tag, max_edge, &mut warnings)?;
         }
+        // Every input face is split into at least subdivision^2 patches.
+        let sub = settings.subdivision.max(1) as f64;
+        check_patch_budget(
+            patches_by_area + faces.faces.len() as f64 * sub * sub,
+            settings,
+            &param_loc("subdivision"),
+            &format!(
+                "subdivision {} on {} faces",
+                settings.subdivision,
+                faces.faces.len()
+            ),
+        )?;
         let Subdivision {
             mut set,
             mut patch_face,
@@ -189,6 +218,39 @@ impl RadiosityScene {
             warnings,
         })
     }
+}
+
+/// Memory per patch, all stages together: the patch and its points, the display mesh,
+/// and the solver's radiosity, unshot and irradiance per band (a round upper figure).
+const BYTES_PER_PATCH: f64 = 512.0;
+
+/// Refuses `patches` (an estimate) when they, or the dense factor matrix the matrix
+/// solvers would build for them, do not fit the memory budget.
+fn check_patch_budget(
+    patches: f64,
+    settings: &RadiositySettings,
+    loc: &radiant_scene::FileLoc,
+    what: &str,
+) -> Result<(), SceneError> {
+    let mut bytes = patches * BYTES_PER_PATCH;
+    let matrix = matches!(
+        settings.solver,
+        SolverKind::GaussSeidel | SolverKind::Jacobi
+    );
+    if matrix {
+        bytes += patches * patches * std::mem::size_of::<f64>() as f64;
+    }
+    radiant_render::budget::check(bytes).map_err(|over| {
+        let matrix_note = if matrix {
+            " and their dense form-factor matrix"
+        } else {
+            ""
+        };
+        SceneError::at(
+            loc,
+            format!("{what} would make {patches:.2e} patches{matrix_note} ({over})"),
+        )
+    })
 }
 
 /// The scene's shapes with their render-from-object transforms (f64), instances

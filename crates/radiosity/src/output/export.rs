@@ -12,6 +12,7 @@ use std::fmt::Write as _;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use radiant_image::atomic::{AtomicFile, atomic_write_bytes};
 use thiserror::Error;
 
 use super::display::DisplayMesh;
@@ -215,11 +216,22 @@ pub fn write_gltf(path: &Path, mesh: &LitMesh, binary: bool) -> Result<(), Expor
         out.extend_from_slice(&(buffer.len() as u32).to_le_bytes());
         out.extend_from_slice(b"BIN\0");
         out.extend_from_slice(&buffer);
-        std::fs::write(path, out).map_err(io_error(path))
+        atomic_write_bytes(path, &out).map_err(io_error(path))
     } else {
+        // Both files complete on disk before either replaces its predecessor, so a failed
+        // write leaves the previous pair as it was.
         let bin_path = path.with_file_name(&bin_name);
-        std::fs::write(&bin_path, &buffer).map_err(io_error(&bin_path))?;
-        std::fs::write(path, json).map_err(io_error(path))
+        let mut bin = AtomicFile::create(&bin_path).map_err(io_error(&bin_path))?;
+        bin.writer()
+            .write_all(&buffer)
+            .map_err(io_error(&bin_path))?;
+        let mut gltf = AtomicFile::create(path).map_err(io_error(path))?;
+        gltf.writer()
+            .write_all(json.as_bytes())
+            .map_err(io_error(path))?;
+        gltf.writer().flush().map_err(io_error(path))?;
+        bin.commit().map_err(io_error(&bin_path))?;
+        gltf.commit().map_err(io_error(path))
     }
 }
 
@@ -279,7 +291,7 @@ pub fn write_ply(path: &Path, mesh: &LitMesh, ascii: bool) -> Result<(), ExportE
             }
         }
     }
-    std::fs::write(path, out).map_err(io_error(path))
+    atomic_write_bytes(path, &out).map_err(io_error(path))
 }
 
 /// One row per patch: index, area, centroid, normal, reflectance, emission `E`,
@@ -290,13 +302,13 @@ pub fn write_patch_csv(
     scene: &RadiosityScene,
     solution: &Solution,
 ) -> Result<(), ExportError> {
-    let file = std::fs::File::create(path).map_err(io_error(path))?;
-    let mut w = std::io::BufWriter::new(file);
+    let mut file = AtomicFile::create(path).map_err(io_error(path))?;
+    let w = file.writer();
     let write = |w: &mut std::io::BufWriter<std::fs::File>, s: &str| {
         w.write_all(s.as_bytes()).map_err(io_error(path))
     };
     write(
-        &mut w,
+        w,
         "patch,area,cx,cy,cz,nx,ny,nz,rho_r,rho_g,rho_b,E_r,E_g,E_b,B_r,B_g,B_b,H_r,H_g,H_b\n",
     )?;
     let mut line = String::new();
@@ -318,7 +330,7 @@ pub fn write_patch_csv(
             }
         }
         line.push('\n');
-        write(&mut w, &line)?;
+        write(w, &line)?;
     }
-    w.flush().map_err(io_error(path))
+    file.commit().map_err(io_error(path))
 }

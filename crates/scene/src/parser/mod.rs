@@ -68,9 +68,53 @@ impl ReadError {
     }
 }
 
-/// Reads a text file, reporting the position of invalid UTF-8.
+/// The largest scene or included file read, in bytes. Scenes of that size keep their
+/// geometry in PLY files; a larger text is almost surely a wrong path (a device, a log).
+pub const MAX_SCENE_FILE_BYTES: u64 = 1 << 30;
+
+/// Reads a text file, reporting the position of invalid UTF-8. Devices (`/dev/zero`)
+/// are refused before reading and any file stops at [`MAX_SCENE_FILE_BYTES`]; pipes
+/// (`<(...)`) are read up to that limit.
 pub(crate) fn read_text(path: &Path) -> Result<String, ReadError> {
-    let bytes = std::fs::read(path).map_err(ReadError::Io)?;
+    use std::io::Read;
+    let too_large = || {
+        ReadError::Io(std::io::Error::new(
+            std::io::ErrorKind::FileTooLarge,
+            format!(
+                "larger than the limit of {} MiB for a scene file",
+                MAX_SCENE_FILE_BYTES >> 20
+            ),
+        ))
+    };
+    let file = std::fs::File::open(path).map_err(ReadError::Io)?;
+    let meta = file.metadata().map_err(ReadError::Io)?;
+    if meta.is_dir() {
+        return Err(ReadError::Io(std::io::Error::new(
+            std::io::ErrorKind::IsADirectory,
+            "is a folder",
+        )));
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        let t = meta.file_type();
+        if t.is_char_device() || t.is_block_device() || t.is_socket() {
+            return Err(ReadError::Io(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "is a device, not a scene file",
+            )));
+        }
+    }
+    if meta.len() > MAX_SCENE_FILE_BYTES {
+        return Err(too_large());
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(MAX_SCENE_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(ReadError::Io)?;
+    if bytes.len() as u64 > MAX_SCENE_FILE_BYTES {
+        return Err(too_large());
+    }
     String::from_utf8(bytes).map_err(|e| {
         let good = &e.as_bytes()[..e.utf8_error().valid_up_to()];
         let line = good.iter().filter(|&&b| b == b'\n').count() as u32 + 1;
@@ -376,7 +420,10 @@ impl Parser {
             "ObjectEnd" => self.object_end(loc),
             "ObjectInstance" => self.object_instance(loc),
             "Include" | "Import" => self.include(loc),
-            _ => Err(SceneError::at(loc, format!("unknown directive '{name}'"))),
+            _ => Err(SceneError::at(
+                loc,
+                format!("unknown directive '{}'", crate::token::excerpt(name)),
+            )),
         }
     }
 
@@ -474,8 +521,10 @@ impl Parser {
                 radius: Vec2::splat(1.5),
                 loc: loc.clone(),
             }),
+            // pbrt-v4's default is "volpath"; without media it is the path tracer, and a
+            // default nobody wrote deserves no warning about media.
             integrator: self.integrator.unwrap_or_else(|| IntegratorDesc {
-                name: "volpath".into(),
+                name: "path".into(),
                 params: ParamSet::new().with("maxdepth", ParamValue::Int(vec![5])),
                 loc,
             }),

@@ -118,7 +118,8 @@ pub struct PhotonMaps {
 
 impl PhotonMaps {
     /// Traces both photon passes and builds the maps. Deterministic for a given seed at
-    /// any thread count. Stops early (with partial maps) when `progress` is cancelled.
+    /// any thread count. Stops early when `progress` is cancelled, and then leaves the maps
+    /// empty: nothing is rendered from them.
     pub fn build(
         world: &World,
         settings: &PhotonSettings,
@@ -191,25 +192,39 @@ impl PhotonMaps {
         stats.projection_fraction = projection.as_ref().map(|p| p.covered_power_fraction);
         stats.rays = global_rays + caustic_rays;
 
+        // Once stopped, nothing will be rendered from the maps: building their trees and
+        // the irradiance cache over what was traced (tens of seconds at 10^8 photons)
+        // would only delay the exit.
+        let stopped = progress.cancelled();
+        let (global_raw, caustic_raw) = if stopped {
+            (Vec::new(), Vec::new())
+        } else {
+            (global_raw, caustic_raw)
+        };
         let t1 = Instant::now();
         let global = PhotonMap::build(global_raw);
-        let caustic = PhotonMap::build(caustic_raw);
+        let caustic = if progress.cancelled() {
+            PhotonMap::build(Vec::new())
+        } else {
+            PhotonMap::build(caustic_raw)
+        };
         stats.build_seconds = t1.elapsed().as_secs_f64();
         stats.global_stored = global.len() as u64;
         stats.caustic_stored = caustic.len() as u64;
 
         let max_r2 = max_radius * max_radius;
         let t2 = Instant::now();
-        let irradiance = (!visualize && settings.final_gather_samples > 0).then(|| {
-            IrradianceCache::build(
-                &global,
-                &caustic,
-                settings.global_lookup,
-                settings.lookup,
-                max_r2,
-                settings.kernel,
-            )
-        });
+        let irradiance = (!visualize && settings.final_gather_samples > 0 && !progress.cancelled())
+            .then(|| {
+                IrradianceCache::build(
+                    &global,
+                    &caustic,
+                    settings.global_lookup,
+                    settings.lookup,
+                    max_r2,
+                    settings.kernel,
+                )
+            });
         stats.precompute_seconds = t2.elapsed().as_secs_f64();
         stats.irradiance_points = irradiance.as_ref().map_or(0, |c| c.len() as u64);
         PhotonMaps {

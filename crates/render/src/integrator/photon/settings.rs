@@ -146,15 +146,40 @@ impl PhotonSettings {
         } else {
             None
         };
+        let photons = p.count("photons", d.photons)?;
+        let caustic_photons = p.count("causticphotons", d.caustic_photons)?;
+        let max_depth = p.count("maxdepth", d.max_depth)?;
+        // The maps before they are traced: each emitted photon is stored at its diffuse
+        // hits — on average 1/(1 - albedo) under Russian roulette, about 2.5 in a closed
+        // room of albedo 0.6, at most `maxdepth` — held twice while the per-thread
+        // buffers are merged, plus the kd-tree's split axes.
+        let stored_per_emitted = (max_depth as f64).clamp(1.0, 2.5);
+        let bytes = (photons as f64 + caustic_photons as f64)
+            * stored_per_emitted
+            * (2 * std::mem::size_of::<super::record::Photon>() + 1) as f64;
+        if let Err(over) = crate::budget::check(bytes) {
+            let name = if p.has("photons") {
+                "photons"
+            } else {
+                "causticphotons"
+            };
+            let loc = p.lookup(name).map_or(&desc.loc, |q| &q.loc);
+            return Err(SceneError::at(
+                loc,
+                format!(
+                    "{photons} photons and {caustic_photons} caustic photons would make maps of {over}"
+                ),
+            ));
+        }
         Ok(PhotonSettings {
-            photons: p.count("photons", d.photons)?,
-            caustic_photons: p.count("causticphotons", d.caustic_photons)?,
+            photons,
+            caustic_photons,
             lookup: p.count("lookup", d.lookup)?.max(1),
             global_lookup: p.count("globallookup", d.global_lookup)?.max(1),
             max_radius,
             final_gather_samples: p.count("finalgathersamples", d.final_gather_samples)?,
             projection_maps: p.bool("projectionmaps", d.projection_maps)?,
-            max_depth: p.count("maxdepth", d.max_depth)?,
+            max_depth,
             kernel,
             visualize,
             seed,
