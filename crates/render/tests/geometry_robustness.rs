@@ -161,6 +161,19 @@ fn check_flat(world: &World, eye: Vec3, targets: &[Vec3], size: f32, tally: &mut
                 tally.fail(format!("p {} to {to} blocked", hit.p));
             }
         }
+        // And far points in front, as a light across a room is.
+        for _ in 0..RANDOM_DIRECTIONS {
+            let w = sampling::uniform_sphere(rand2(&mut rng));
+            let to = hit.p + size * 2.0 * if w.dot(n) < 0.0 { -w } else { w };
+            if (to - hit.p).dot(n) <= 1e-5 * to.abs().max_element() {
+                continue;
+            }
+            tally.rays += 1;
+            if !world.visible(&sp, &SurfacePoint::free(to)) {
+                tally.blocked += 1;
+                tally.fail(format!("p {} to {to} blocked", hit.p));
+            }
+        }
     }
 }
 
@@ -186,17 +199,25 @@ fn rays_leaving_axis_aligned_triangles_never_hit_them() {
     let mut rng = Pcg32::new(1, 2);
     for axis in 0..3 {
         for s in SCALES {
-            for (plane, along) in [(0.0, 0.0), (0.0, 370.0), (0.37, 0.0), (-13.0, 290.0)] {
+            // (plane, centre along the plane, half-size): the last is a wall of a room
+            // with a corner at the origin.
+            for (plane, along, half) in [
+                (0.0, 0.0, 10.0),
+                (0.0, 370.0, 10.0),
+                (0.37, 0.0, 10.0),
+                (-13.0, 290.0, 10.0),
+                (0.0, 280.0, 280.0),
+            ] {
                 let mut centre = Vec3::splat(along * s);
                 centre[axis] = plane * s;
-                let half = 10.0 * s;
+                let half = half * s;
                 let world = world_of(vec![square(axis, centre, half)]);
                 let targets = square_targets(axis, centre, half, &mut rng);
                 let mut tally = Tally::default();
                 for side in [1.0, -1.0] {
                     for tilt in [0.0, 3.0] {
-                        let mut eye = centre + Vec3::splat(tilt * s);
-                        eye[axis] = centre[axis] + side * 4.0 * s;
+                        let mut eye = centre + Vec3::splat(tilt * half * 0.1);
+                        eye[axis] = centre[axis] + side * 0.4 * half;
                         check_flat(&world, eye, &targets, half, &mut tally);
                     }
                 }
