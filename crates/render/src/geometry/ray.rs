@@ -129,8 +129,10 @@ impl SurfacePoint {
 /// `p` moved along `n` (to the side of `w`) past its error box `p_error`, then rounded one
 /// ulp further away from the surface in every moved component.
 pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
-    // The box's half-extent along n (in units of |n|, so n need not be normalised).
-    let d = n.abs().dot(p_error);
+    // The box's half-extent along n, |n|·p_error: raised by γ₄ for the rounding of this
+    // dot product and for a unit normal whose computed length falls a few ulps short of 1
+    // (the move d·n must still cover the box along the true direction of n).
+    let d = n.abs().dot(p_error) * (1.0 + gamma(4));
     let mut offset = d * n;
     if w.dot(n) < 0.0 {
         offset = -offset;
