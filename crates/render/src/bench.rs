@@ -85,13 +85,11 @@ pub fn world_ray_benchmark(desc: &SceneDesc, size: u32, repetitions: u32) -> Wor
             let ctx = h.light_sample_context();
             let chosen = world.light_sampler.sample(&ctx, s.get_1d())?;
             let ls = world.lights[chosen.index].sample_li(&ctx, s.get_2d(), scene)?;
-            let o = h.spawn_origin(ls.wi);
-            let dist = if ls.at_infinity {
-                f32::INFINITY
+            Some(if ls.at_infinity {
+                (h.spawn_ray(ls.wi), f32::INFINITY)
             } else {
-                (ls.p_light.p - o).length() * 0.999
-            };
-            Some((crate::geometry::Ray::new(o, ls.wi), dist))
+                h.surface_point().spawn_ray_to(&ls.p_light)
+            })
         })
         .collect();
     let best = |f: &dyn Fn() -> usize| -> f64 {

@@ -5,7 +5,9 @@
 //! (needed later for vertex radiosities and Gouraud display). Geometry is shared by
 //! the three colour bands; emission `E` and reflectance `rho` are per band.
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
+use radiant_render::geometry::SurfacePoint;
+use radiant_render::geometry::ray::gamma;
 use thiserror::Error;
 
 /// Why a patch was rejected.
@@ -154,6 +156,26 @@ impl PatchSet {
             self.points.truncate(first as usize);
         }
         added
+    }
+
+    /// Patch `i`'s point `p` (with normal `n`) as a place rays start from or end at, in
+    /// the renderer's f32, with the error bound [`point_error`](Self::point_error).
+    pub fn surface_point(&self, i: usize, p: DVec3, n: Vec3) -> SurfacePoint {
+        SurfacePoint::new(p.as_vec3(), self.point_error(i), n)
+    }
+
+    /// How far a point of patch `i` rounded to f32 may lie off the renderer's surface, per
+    /// component. The renderer's triangles are the patch's faces rounded to f32, and the
+    /// point is rounded once more, so it may lie off them by a few ulps of the largest
+    /// corner coordinate (not of the point's own, which may be near zero on a tilted
+    /// face): γ₄ of the corners' magnitudes, which also bound every point inside.
+    pub fn point_error(&self, i: usize) -> Vec3 {
+        let reach = self
+            .polygon(i)
+            .as_slice()
+            .iter()
+            .fold(DVec3::ZERO, |m, c| m.max(c.abs()));
+        gamma(4) * reach.as_vec3()
     }
 
     /// The corner positions of patch `i`.

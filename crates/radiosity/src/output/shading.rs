@@ -17,7 +17,7 @@ use crate::visibility::bvh::FaceVisibility;
 use radiant_math::color::Rgb;
 use radiant_math::{Frame, sampling};
 use radiant_render::geometry::Ray;
-use radiant_render::geometry::ray::offset_origin;
+use radiant_render::geometry::SurfacePoint;
 use radiant_render::integrator::specular::specular_bounce;
 use radiant_render::integrator::{PixelEstimator, PixelId};
 use radiant_render::light::LightSampleContext;
@@ -155,7 +155,11 @@ impl<'a> Shading<'a> {
                     break;
                 };
                 let ng = self.scene.patches.patches[hit.struck].normal.as_vec3();
-                ray = Ray::new(offset_origin(hit.p.as_vec3(), ng, wi), wi);
+                ray = self
+                    .scene
+                    .patches
+                    .surface_point(hit.struck, hit.p, ng)
+                    .spawn_ray(wi);
                 continue;
             }
             let Some(i) = hit.patch else { break };
@@ -166,7 +170,8 @@ impl<'a> Shading<'a> {
                 break;
             }
             let albedo = Rgb::from_array(patch.reflectance.map(|r| r as f32));
-            let (reflected, traced) = self.gather(hit.p, n, self.final_gather, true, sampler);
+            let at = self.scene.patches.surface_point(i, hit.p, n);
+            let (reflected, traced) = self.gather(&at, self.final_gather, true, sampler);
             rays += traced;
             l += beta * (self.emission(i) * inv_pi + albedo * reflected);
             break;
@@ -182,14 +187,13 @@ impl<'a> Shading<'a> {
     /// is shaded by a second, smaller gather there instead.
     fn gather(
         &self,
-        x: DVec3,
-        n: Vec3,
+        at: &SurfacePoint,
         count: u32,
         refine_near: bool,
         sampler: &mut PixelSample,
     ) -> (Rgb, u32) {
         let inv_pi = std::f32::consts::FRAC_1_PI;
-        let p = x.as_vec3();
+        let (p, n) = (at.p, at.n);
         let mut rays = 0;
         let mut direct = Rgb::BLACK;
         let u_light = sampler.get_1d();
@@ -208,14 +212,11 @@ impl<'a> Shading<'a> {
             let cos = n.dot(ls.wi);
             if cos > 0.0 && ls.pdf > 0.0 {
                 rays += 1;
-                let o = offset_origin(p, n, ls.wi);
                 let blocked = if ls.at_infinity {
-                    self.occluders.occluded(&Ray::new(o, ls.wi), f32::INFINITY)
+                    self.occluders.occluded(&at.spawn_ray(ls.wi), f32::INFINITY)
                 } else {
-                    let q = ls.p_light;
-                    let target = offset_origin(q.p, q.n, o - q.p);
-                    self.occluders
-                        .occluded(&Ray::new(o, target - o), 1.0 - 1e-4)
+                    let (ray, t_max) = at.spawn_ray_to(&ls.p_light);
+                    self.occluders.occluded(&ray, t_max)
                 };
                 if !blocked {
                     direct = ls.li * (cos / (pmf * ls.pdf));
@@ -228,7 +229,7 @@ impl<'a> Shading<'a> {
         for _ in 0..count {
             let w = frame.to_world(sampling::cosine_hemisphere(sampler.get_2d()));
             rays += 1;
-            let ray = Ray::new(offset_origin(p, n, w), w);
+            let ray = at.spawn_ray(w);
             let Some(hit) = self.tracer.intersect(self.scene, &ray, f32::INFINITY) else {
                 continue;
             };
@@ -237,8 +238,12 @@ impl<'a> Shading<'a> {
             let diffuse = !self.world.materials[self.scene.tag(j).material as usize].is_specular();
             if refine_near && hit.t < near && diffuse {
                 let facing = patch.normal.as_vec3();
-                let (reflected, traced) =
-                    self.gather(hit.p, facing, (count / 4).max(1), false, sampler);
+                let (reflected, traced) = self.gather(
+                    &self.scene.patches.surface_point(j, hit.p, facing),
+                    (count / 4).max(1),
+                    false,
+                    sampler,
+                );
                 rays += traced;
                 let albedo = Rgb::from_array(patch.reflectance.map(|r| r as f32));
                 indirect += albedo * reflected * std::f32::consts::PI;

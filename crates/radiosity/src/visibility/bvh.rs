@@ -1,9 +1,10 @@
 //! Shadow rays through the renderer's BVHs: against the render [`World`], or against a
 //! triangle BVH over the unsubdivided faces the patches were cut from.
 //!
-//! Both offset the segment off the two surfaces it joins, along each patch's normal
-//! towards the other end (the world's self-intersection offset), and stop a hair short
-//! of the far end, so the endpoints' own surfaces never count as occluders.
+//! Both move the segment's ends off the two surfaces they lie on, along each patch's
+//! normal towards the other end — the world past each point's rounding-error bound
+//! (`World::visible`), the faces by a lift scaled to the scene — and stop a hair short of
+//! the far end, so the endpoints' own surfaces never count as occluders.
 
 use glam::{DVec3, Vec3};
 
@@ -13,22 +14,29 @@ use crate::mesh::meshed_scene::RadiosityScene;
 use crate::mesh::patch::PatchSet;
 use radiant_render::accel::TriangleBvh;
 use radiant_render::geometry::Ray;
-use radiant_render::geometry::ray::offset_origin;
+use radiant_render::geometry::SurfacePoint;
 use radiant_render::world::World;
 
 /// Patch index meaning "not on a patch" (a sensor or a light position).
 pub const NO_PATCH: usize = usize::MAX;
 
 /// Fraction of the segment left out at the far end (as `World::visible`).
-const FAR_END: f32 = 1e-4;
+const FAR_END: f32 = radiant_render::geometry::SHADOW_EPSILON;
 
-/// The segment `p0 -> p1` offset off both surfaces (normals `n0`, `n1`; zero for a point
-/// in free space), as a ray with `t` in `[0, 1 - FAR_END)`.
+/// Per patch, the normal and error bound its points get as segment ends.
+fn segment_ends(set: &PatchSet) -> Vec<(Vec3, Vec3)> {
+    (0..set.patches.len())
+        .map(|i| (set.patches[i].normal.as_vec3(), set.point_error(i)))
+        .collect()
+}
+
+/// The end of a segment on patch `patch` (or in free space for [`NO_PATCH`]).
 #[inline]
-fn offset_segment(p0: Vec3, n0: Vec3, p1: Vec3, n1: Vec3) -> Ray {
-    let o = offset_origin(p0, n0, p1 - p0);
-    let target = offset_origin(p1, n1, o - p1);
-    Ray::new(o, target - o)
+fn segment_end(ends: &[(Vec3, Vec3)], p: DVec3, patch: usize) -> SurfacePoint {
+    match ends.get(patch) {
+        Some(&(n, err)) => SurfacePoint::new(p.as_vec3(), err, n),
+        None => SurfacePoint::free(p.as_vec3()),
+    }
 }
 
 fn patch_normals(set: &PatchSet) -> Vec<Vec3> {
@@ -45,27 +53,25 @@ fn normal_of(normals: &[Vec3], patch: usize) -> Vec3 {
 /// shapes lie inside them and would shadow themselves, so use [`FaceVisibility`] there.
 pub struct WorldVisibility<'a> {
     world: &'a World,
-    normals: Vec<Vec3>,
+    /// Normal and point error bound of each patch.
+    ends: Vec<(Vec3, Vec3)>,
 }
 
 impl<'a> WorldVisibility<'a> {
     pub fn new(world: &'a World, set: &PatchSet) -> WorldVisibility<'a> {
         WorldVisibility {
             world,
-            normals: patch_normals(set),
+            ends: segment_ends(set),
         }
     }
 }
 
 impl Visibility for WorldVisibility<'_> {
     fn visible(&self, from: DVec3, to: DVec3, from_patch: usize, to_patch: usize) -> bool {
-        let ray = offset_segment(
-            from.as_vec3(),
-            normal_of(&self.normals, from_patch),
-            to.as_vec3(),
-            normal_of(&self.normals, to_patch),
-        );
-        !self.world.occluded(&ray, 1.0 - FAR_END)
+        self.world.visible(
+            &segment_end(&self.ends, from, from_patch),
+            &segment_end(&self.ends, to, to_patch),
+        )
     }
 }
 

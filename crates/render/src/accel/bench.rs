@@ -5,7 +5,8 @@
 
 use super::displaced_sphere::{cornell_box_walls, displaced_sphere};
 use super::{MeshHit, TriangleBvh};
-use crate::geometry::ray::offset_origin;
+use crate::geometry::SurfacePoint;
+use crate::geometry::ray::barycentric_error;
 use crate::geometry::{Ray, triangle::triangle_normal};
 use radiant_math::hash::{hash_u64s, u32_to_unit_f32};
 use radiant_math::sampling::cosine_hemisphere;
@@ -227,7 +228,7 @@ pub fn ray_benchmark(config: &RayBenchConfig) -> RayBenchFigures {
     let (cam_hits, cam_time) = timed(&cam, reps, |r, t| bvh.intersect(r, t));
 
     // Surface points of the camera hits, with the geometric normal facing the camera.
-    let surface: Vec<(Vec3, Vec3)> = cam
+    let surface: Vec<SurfacePoint> = cam
         .iter()
         .zip(&cam_hits)
         .filter_map(|((ray, _), hit): (&(Ray, f32), &Option<MeshHit>)| {
@@ -235,20 +236,24 @@ pub fn ray_benchmark(config: &RayBenchConfig) -> RayBenchFigures {
             let p = mesh.triangles[h.prim as usize].map(|i| mesh.vertices[i as usize]);
             let point = h.b[0] * p[0] + h.b[1] * p[1] + h.b[2] * p[2];
             let n = triangle_normal(p[0], p[1], p[2]);
-            Some((point, if n.dot(ray.d) > 0.0 { -n } else { n }))
+            Some(SurfacePoint::new(
+                point,
+                barycentric_error(h.b, p),
+                if n.dot(ray.d) > 0.0 { -n } else { n },
+            ))
         })
         .collect();
 
     let diffuse: Vec<(Ray, f32)> = surface
         .iter()
         .enumerate()
-        .map(|(i, &(p, n))| {
-            let d = Frame::from_normal(n).to_world(cosine_hemisphere(uniform2(
+        .map(|(i, sp)| {
+            let d = Frame::from_normal(sp.n).to_world(cosine_hemisphere(uniform2(
                 config.seed,
                 i as u64,
                 0,
             )));
-            (Ray::new(offset_origin(p, n, d), d), f32::INFINITY)
+            (sp.spawn_ray(d), f32::INFINITY)
         })
         .collect();
     let (diffuse_hits, diffuse_time) = timed(&diffuse, reps, |r, t| bvh.intersect(r, t).is_some());
@@ -256,12 +261,11 @@ pub fn ray_benchmark(config: &RayBenchConfig) -> RayBenchFigures {
     let shadow: Vec<(Ray, f32)> = surface
         .iter()
         .enumerate()
-        .map(|(i, &(p, n))| {
+        .map(|(i, sp)| {
             let u = uniform2(config.seed, i as u64, 1);
             let target = Vec3::new(213.0 + 130.0 * u.x, 548.7, 227.0 + 105.0 * u.y);
-            let o = offset_origin(p, n, target - p);
             // Stop just short of the light, which is not part of the occluding geometry.
-            (Ray::new(o, target - o), 1.0 - 1e-4)
+            sp.spawn_ray_to(&SurfacePoint::free(target))
         })
         .collect();
     let (occluded, shadow_time) = timed(&shadow, reps, |r, t| bvh.occluded(r, t));

@@ -112,7 +112,9 @@ fn triangle_bvh_and_generic_bvh_equal_brute_force() {
             }
         }
     }
-    assert!(checked_hits > 5000, "{checked_hits}");
+    // Hits on the slivers (one ulp wide) have a distance whose sign the triangle test's
+    // rounding-error bound cannot certify; they are refused alike by every kernel.
+    assert!(checked_hits > 4500, "{checked_hits}");
 }
 
 #[test]

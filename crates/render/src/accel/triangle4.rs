@@ -6,6 +6,7 @@
 //! order (Rust never contracts to FMA), so the SIMD and scalar kernels agree bit for bit and
 //! the packed BVH inherits the scalar test's watertightness.
 
+use crate::geometry::ray::gamma;
 use crate::geometry::triangle::{WatertightRay, edge_functions_f64};
 use glam::{BVec4A, Vec3, Vec4};
 
@@ -94,7 +95,23 @@ pub(crate) fn intersect4(ray: &WatertightRay4, tri: &Triangle4, t_max: f32) -> L
     let t = (u * az + v * bz + w * cz) * (sz / det);
     // det = 0 gives t = ±∞ or NaN, which the range test rejects, as the scalar kernel does.
     let in_range = t.cmpgt(Vec4::ZERO) & t.cmplt(Vec4::splat(t_max));
-    let hit = in_range.bitmask() & !(lo.cmplt(Vec4::ZERO) & hi.cmpgt(Vec4::ZERO)).bitmask();
+    let mut hit = in_range.bitmask() & !(lo.cmplt(Vec4::ZERO) & hi.cmpgt(Vec4::ZERO)).bitmask();
+    if hit != 0 {
+        // The scalar kernel's t_error_bound, lane-wise: only hits with a provably
+        // positive t remain.
+        let max_x = ax.abs().max(bx.abs()).max(cx.abs());
+        let max_y = ay.abs().max(by.abs()).max(cy.abs());
+        let max_z = az.abs().max(bz.abs()).max(cz.abs());
+        let max_e = u.abs().max(v.abs()).max(w.abs());
+        let g = |n: i32| Vec4::splat(gamma(n));
+        let two = Vec4::splat(2.0);
+        let dz = g(1) * max_z;
+        let dx = g(5) * (max_x + two * max_z);
+        let dy = g(5) * (max_y + two * max_z);
+        let de = two * (g(2) * max_x * max_y + dy * max_x + dx * max_y);
+        let dt = Vec4::splat(3.0) * (g(3) * max_e * max_z + de * max_z + dz * max_e);
+        hit &= t.cmpgt(dt * (sz / det).abs()).bitmask();
+    }
     Lanes {
         u,
         v,

@@ -13,6 +13,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use super::Ray;
+use super::ray::{barycentric_error, gamma};
 use super::sample::AreaSample;
 use super::triangle::{WatertightRay, intersect_triangle};
 use glam::{DVec2, Vec2, Vec3};
@@ -30,6 +31,9 @@ pub struct BilinearPatch {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BilinearHit {
     pub t: f32,
+    /// The hit point on the patch and a bound on its error per component.
+    pub p: Vec3,
+    pub p_error: Vec3,
     pub uv: Vec2,
     /// Unit normal along ∂p/∂u × ∂p/∂v.
     pub n: Vec3,
@@ -50,6 +54,18 @@ impl BilinearPatch {
             + u * (1.0 - v) * self.p10
             + (1.0 - u) * v * self.p01
             + u * v * self.p11
+    }
+
+    /// [`point`](Self::point) with a bound on its error: four weights of up to three
+    /// roundings each, four products and three sums — γ₇ of the absolute terms, which also
+    /// covers weights that do not sum exactly to one.
+    pub fn point_with_error(&self, uv: Vec2) -> (Vec3, Vec3) {
+        let (u, v) = (uv.x, uv.y);
+        let terms = ((1.0 - u) * (1.0 - v) * self.p00).abs()
+            + (u * (1.0 - v) * self.p10).abs()
+            + ((1.0 - u) * v * self.p01).abs()
+            + (u * v * self.p11).abs();
+        (self.point(uv), gamma(7) * terms)
     }
 
     /// The partial derivatives (∂p/∂u, ∂p/∂v) at `uv`.
@@ -98,20 +114,17 @@ impl BilinearPatch {
         let h0 = intersect_triangle(&wr, self.p00, self.p10, self.p11, t_max);
         let t_max = h0.map_or(t_max, |h| h.t);
         let h1 = intersect_triangle(&wr, self.p00, self.p11, self.p01, t_max);
-        let (p, t) = match (h0, h1) {
-            (_, Some(h)) => (
-                h.b[0] * self.p00 + h.b[1] * self.p11 + h.b[2] * self.p01,
-                h.t,
-            ),
-            (Some(h), None) => (
-                h.b[0] * self.p00 + h.b[1] * self.p10 + h.b[2] * self.p11,
-                h.t,
-            ),
+        let (h, corners) = match (h0, h1) {
+            (_, Some(h)) => (h, [self.p00, self.p11, self.p01]),
+            (Some(h), None) => (h, [self.p00, self.p10, self.p11]),
             (None, None) => return None,
         };
+        let p = h.b[0] * corners[0] + h.b[1] * corners[1] + h.b[2] * corners[2];
         let uv = self.planar_uv(p);
         Some(BilinearHit {
-            t,
+            t: h.t,
+            p,
+            p_error: barycentric_error(h.b, corners),
             uv,
             n: self.normal(uv),
         })
@@ -205,8 +218,11 @@ impl BilinearPatch {
             if t > 0.0 && t < t_best && (0.0..=1.0).contains(&v) {
                 t_best = t;
                 let uv = Vec2::new(u, v);
+                let (p, p_error) = self.point_with_error(uv);
                 best = Some(BilinearHit {
                     t,
+                    p,
+                    p_error,
                     uv,
                     n: self.normal(uv),
                 });
@@ -237,8 +253,10 @@ impl BilinearPatch {
         if !(j > 0.0) {
             return None;
         }
+        let (p, p_error) = self.point_with_error(u);
         Some(AreaSample {
-            p: self.point(u),
+            p,
+            p_error,
             n: self.normal(u),
             pdf: 1.0 / j,
         })

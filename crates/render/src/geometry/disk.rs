@@ -24,7 +24,8 @@ pub struct Disk {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DiskHit {
     pub t: f32,
-    /// Hit point, exactly in the disk's plane.
+    /// Hit point, exactly in the disk's plane (so its error bound is zero: it is a point of
+    /// the surface, though not exactly the ray's).
     pub p: Vec3,
     /// u = phi / phi_max; v = (radius − r) / (radius − inner_radius) (1 at the inner edge).
     pub uv: Vec2,
@@ -116,6 +117,8 @@ impl Disk {
         };
         AreaSample {
             p: Vec3::new(xy.x, xy.y, self.height),
+            // On the plane exactly.
+            p_error: Vec3::ZERO,
             n: Vec3::Z,
             pdf: 1.0 / self.area(),
         }

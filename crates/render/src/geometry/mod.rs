@@ -11,7 +11,7 @@ pub mod triangle;
 pub use bilinear::{BilinearHit, BilinearPatch};
 pub use bounds::Aabb;
 pub use disk::{Disk, DiskHit};
-pub use ray::Ray;
+pub use ray::{Ray, SHADOW_EPSILON, SurfacePoint};
 pub use sample::{AreaSample, ShapeError, SolidAngleSample, area_pdf_to_solid_angle};
 pub use sphere::{Sphere, SphereHit};
 pub use triangle::{

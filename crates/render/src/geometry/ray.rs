@@ -1,6 +1,20 @@
-//! Rays.
+//! Rays, and where rays leaving a surface start.
+//!
+//! A computed intersection point is not on the surface: it carries rounding error. A ray
+//! started there may find the same surface again at a tiny distance ("shadow acne") or pass
+//! through it. Every shape therefore returns, with its hit point `p`, a conservative bound
+//! `p_error` on `|p − p_exact|` per component (forward error analysis as in Higham,
+//! *Accuracy and Stability of Numerical Algorithms*, §3, with the γₙ bound on n rounded
+//! operations). Spawned rays start at `p` moved along the geometric normal just far enough
+//! that the whole error box lies behind them — the box's extent along the normal is
+//! `|n| · p_error` — and then one ulp further away, so the move survives its own rounding.
+//! The ray–triangle test then only accepts distances that are provably positive. This is
+//! the approach of Pharr, Jakob & Humphreys, *Physically Based Rendering* (4th ed., §6.8);
+//! Wächter & Binder (*Ray Tracing Gems*, ch. 6) discuss the same problem. All offsets scale
+//! with the coordinates, so nothing depends on the scene's unit of length.
 
 use glam::Vec3;
+use radiant_math::Transform;
 
 /// A ray `o + t d`. `d` need not be normalised; hit distances are in units of `|d|`.
 /// The valid interval `[0, t_max)` is passed to queries separately.
@@ -20,63 +34,193 @@ impl Ray {
     }
 }
 
-/// Offsets a ray origin off a surface along the geometric normal, on the side of `w`,
-/// by an amount that scales with the magnitude of the coordinates so that self-
-/// intersection is avoided at any scene scale (in the spirit of Wächter & Binder,
-/// "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing Gems 2019).
-pub fn offset_origin(p: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
-    const ORIGIN: f32 = 1.0 / 32.0;
-    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
-    const INT_SCALE: f32 = 256.0;
-    let n = if ng.dot(w) < 0.0 { -ng } else { ng };
-    let of_i = [
-        (INT_SCALE * n.x) as i32,
-        (INT_SCALE * n.y) as i32,
-        (INT_SCALE * n.z) as i32,
-    ];
-    let bump = |c: f32, o: i32| -> f32 {
-        let bits = c.to_bits() as i32;
-        let moved = if c < 0.0 { bits - o } else { bits + o };
-        f32::from_bits(moved as u32)
-    };
-    let p_i = Vec3::new(bump(p.x, of_i[0]), bump(p.y, of_i[1]), bump(p.z, of_i[2]));
-    Vec3::new(
-        if p.x.abs() < ORIGIN {
-            p.x + FLOAT_SCALE * n.x
-        } else {
-            p_i.x
-        },
-        if p.y.abs() < ORIGIN {
-            p.y + FLOAT_SCALE * n.y
-        } else {
-            p_i.y
-        },
-        if p.z.abs() < ORIGIN {
-            p.z + FLOAT_SCALE * n.z
-        } else {
-            p_i.z
-        },
-    )
+/// Where a shadow ray between two points stops, as a fraction of the segment: short of
+/// the far end, whose surface must not count as a blocker. The ends are already moved off
+/// their surfaces, so this only guards against the far point's own rounding.
+pub const SHADOW_EPSILON: f32 = 1e-4;
+
+/// Half an ulp of 1: the relative error of one correctly rounded f32 operation.
+pub const MACHINE_EPSILON: f32 = f32::EPSILON * 0.5;
+
+/// γₙ = nε / (1 − nε): bounds the relative error accumulated by n rounded operations.
+#[inline(always)]
+pub const fn gamma(n: i32) -> f32 {
+    (n as f32 * MACHINE_EPSILON) / (1.0 - n as f32 * MACHINE_EPSILON)
+}
+
+/// The smallest float greater than `x` (`x` itself for +∞ and NaN).
+#[inline]
+pub fn next_float_up(x: f32) -> f32 {
+    if x.is_nan() || x == f32::INFINITY {
+        return x;
+    }
+    // -0 and +0 both step to the smallest positive subnormal.
+    let x = if x == -0.0 { 0.0 } else { x };
+    let bits = x.to_bits();
+    f32::from_bits(if x >= 0.0 { bits + 1 } else { bits - 1 })
+}
+
+/// The largest float less than `x` (`x` itself for −∞ and NaN).
+#[inline]
+pub fn next_float_down(x: f32) -> f32 {
+    if x.is_nan() || x == f32::NEG_INFINITY {
+        return x;
+    }
+    let x = if x == 0.0 { -0.0 } else { x };
+    let bits = x.to_bits();
+    f32::from_bits(if x > 0.0 { bits - 1 } else { bits + 1 })
+}
+
+/// A point on a surface (or in free space) as a place rays start from or end at: the
+/// computed position, a conservative bound on its error per component, and the geometric
+/// normal (either orientation; zero for points in free space, which are not moved).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfacePoint {
+    pub p: Vec3,
+    pub p_error: Vec3,
+    pub n: Vec3,
+}
+
+impl SurfacePoint {
+    pub fn new(p: Vec3, p_error: Vec3, n: Vec3) -> SurfacePoint {
+        SurfacePoint { p, p_error, n }
+    }
+
+    /// A point in free space (a point light, a camera): rays start exactly there.
+    pub fn free(p: Vec3) -> SurfacePoint {
+        SurfacePoint {
+            p,
+            p_error: Vec3::ZERO,
+            n: Vec3::ZERO,
+        }
+    }
+
+    /// A point known only to within the rounding of its own coordinates (half an ulp
+    /// each, doubled for the operations that made it): points converted from f64 or
+    /// stored positions of vertices and sample points.
+    pub fn rounded(p: Vec3, n: Vec3) -> SurfacePoint {
+        SurfacePoint {
+            p,
+            p_error: gamma(2) * p.abs(),
+            n,
+        }
+    }
+
+    /// The origin for a ray leaving towards `w`: on `w`'s side of the surface, outside the
+    /// error box.
+    pub fn spawn_origin(&self, w: Vec3) -> Vec3 {
+        offset_ray_origin(self.p, self.p_error, self.n, w)
+    }
+
+    pub fn spawn_ray(&self, w: Vec3) -> Ray {
+        Ray::new(self.spawn_origin(w), w)
+    }
+
+    /// A ray for the segment from this point to `to`, both ends moved off their surfaces
+    /// towards each other, and the `t_max` to trace it with (the far end, less
+    /// [`SHADOW_EPSILON`]).
+    pub fn spawn_ray_to(&self, to: &SurfacePoint) -> (Ray, f32) {
+        let o = self.spawn_origin(to.p - self.p);
+        let target = to.spawn_origin(o - to.p);
+        (Ray::new(o, target - o), 1.0 - SHADOW_EPSILON)
+    }
+}
+
+/// `p` moved along `n` (to the side of `w`) past its error box `p_error`, then rounded one
+/// ulp further away from the surface in every moved component.
+pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
+    // The box's half-extent along n, |n|·p_error: raised by γ₄ for the rounding of this
+    // dot product and for a unit normal whose computed length falls a few ulps short of 1
+    // (the move d·n must still cover the box along the true direction of n).
+    let d = n.abs().dot(p_error) * (1.0 + gamma(4));
+    let mut offset = d * n;
+    if w.dot(n) < 0.0 {
+        offset = -offset;
+    }
+    let mut po = p + offset;
+    for i in 0..3 {
+        if offset[i] > 0.0 {
+            po[i] = next_float_up(po[i]);
+        } else if offset[i] < 0.0 {
+            po[i] = next_float_down(po[i]);
+        }
+    }
+    po
+}
+
+/// The error bound of `a₀p₀ + a₁p₁ + a₂p₂` for weights in [0, 1] computed in f32
+/// (barycentric interpolation): each term and the two sums add a rounding, and weights that
+/// were themselves computed (and do not sum exactly to one) shift the point by a few ulps of
+/// the largest term; γ₇ of the absolute terms covers both.
+pub fn barycentric_error(b: [f32; 3], p: [Vec3; 3]) -> Vec3 {
+    gamma(7) * ((b[0] * p[0]).abs() + (b[1] * p[1]).abs() + (b[2] * p[2]).abs())
+}
+
+/// An affine transform of a point with error bound `p_error`, and the bound of the result:
+/// each output coordinate is three products and three sums (γ₃ of the absolute terms),
+/// and the input's error passes through the absolute linear part, itself rounded.
+pub fn transform_point_with_error(xf: &Transform, p: Vec3, p_error: Vec3) -> (Vec3, Vec3) {
+    let m = &xf.m;
+    let (cx, cy, cz, t) = (
+        m.x_axis.truncate(),
+        m.y_axis.truncate(),
+        m.z_axis.truncate(),
+        m.w_axis.truncate(),
+    );
+    let terms = (cx * p.x).abs() + (cy * p.y).abs() + (cz * p.z).abs() + t.abs();
+    let carried = cx.abs() * p_error.x + cy.abs() * p_error.y + cz.abs() * p_error.z;
+    (xf.point(p), gamma(3) * terms + (1.0 + gamma(3)) * carried)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use radiant_math::hash::Pcg32;
 
     #[test]
-    fn offset_moves_to_the_side_of_w() {
+    fn next_float_steps_one_ulp() {
+        for x in [1.0f32, -1.0, 0.0, -0.0, 1e-30, -3.5e7, f32::MAX * 0.5] {
+            let up = next_float_up(x);
+            let down = next_float_down(x);
+            assert!(up > x && down < x, "{x}");
+            // Nothing lies strictly between.
+            assert_eq!(next_float_down(up), if x == 0.0 { 0.0 } else { x });
+            assert_eq!(next_float_up(down), if x == 0.0 { 0.0 } else { x });
+        }
+        assert_eq!(next_float_up(f32::INFINITY), f32::INFINITY);
+        assert_eq!(next_float_down(f32::NEG_INFINITY), f32::NEG_INFINITY);
+    }
+
+    #[test]
+    fn offset_moves_to_the_side_of_w_past_the_error_box() {
+        let mut rng = Pcg32::new(3, 7);
         for &p in &[
             Vec3::ZERO,
             Vec3::new(500.0, -3.0, 1e-3),
             Vec3::new(-1e4, 2e4, 7.0),
         ] {
-            let n = Vec3::new(0.3, 0.9, -0.3).normalize();
-            let up = offset_origin(p, n, n);
-            let down = offset_origin(p, n, -n);
-            assert!((up - p).dot(n) > 0.0);
-            assert!((down - p).dot(n) < 0.0);
-            // At most a few hundred ulps: tiny relative to the coordinates.
-            assert!((up - p).length() < 1e-4 * p.length() + 1e-3);
+            for _ in 0..100 {
+                let n = (Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5)
+                    .normalize_or(Vec3::Z);
+                let err = gamma(7) * p.abs() + Vec3::splat(1e-30);
+                let sp = SurfacePoint::new(p, err, n);
+                let up = sp.spawn_origin(n);
+                let down = sp.spawn_origin(-n);
+                // Every corner of the error box lies strictly behind the moved origin.
+                for k in 0..8 {
+                    let s = Vec3::new(
+                        if k & 1 == 0 { 1.0 } else { -1.0 },
+                        if k & 2 == 0 { 1.0 } else { -1.0 },
+                        if k & 4 == 0 { 1.0 } else { -1.0 },
+                    );
+                    let corner = (p + s * err).as_dvec3();
+                    let nd = n.as_dvec3();
+                    assert!((up.as_dvec3() - corner).dot(nd) > 0.0);
+                    assert!((down.as_dvec3() - corner).dot(nd) < 0.0);
+                }
+                // Tiny relative to the coordinates.
+                assert!((up - p).length() < 1e-5 * p.length() + 1e-6);
+            }
         }
     }
 }

@@ -7,6 +7,8 @@ use glam::Vec3;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AreaSample {
     pub p: Vec3,
+    /// Bound on the error of `p` per component (for moving ray ends off the surface).
+    pub p_error: Vec3,
     /// Unit geometric normal at `p` (the shape's outward / +z side).
     pub n: Vec3,
     /// Density with respect to surface area.
@@ -18,6 +20,8 @@ pub struct AreaSample {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolidAngleSample {
     pub p: Vec3,
+    /// Bound on the error of `p` per component.
+    pub p_error: Vec3,
     /// Unit geometric normal at `p`.
     pub n: Vec3,
     /// Unit direction from the reference point towards `p`.
@@ -53,6 +57,7 @@ pub fn area_to_solid_angle_sample(s: AreaSample, reference: Vec3) -> Option<Soli
     }
     Some(SolidAngleSample {
         p: s.p,
+        p_error: s.p_error,
         n: s.n,
         wi: (s.p - reference).normalize(),
         pdf,

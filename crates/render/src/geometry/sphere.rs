@@ -31,6 +31,8 @@ pub struct SphereHit {
     pub t: f32,
     /// Hit point, re-projected onto the surface.
     pub p: Vec3,
+    /// Bound on the distance of `p` from the exact surface, per component.
+    pub p_error: Vec3,
     /// Unit outward normal.
     pub n: Vec3,
     /// u = phi / phi_max; v runs from 0 at z_min to 1 at z_max (along the polar angle).
@@ -82,18 +84,24 @@ impl Sphere {
     }
 
     /// Closest hit with `0 < t < t_max` on the (possibly cut) surface.
+    ///
+    /// The quadratic is solved in f64 from the exact f32 inputs: its roots then carry a
+    /// relative error near 1e-16, far below the f32 offsets that move a spawned ray's
+    /// origin off the surface, so a ray leaving the sphere never finds it again at t ≈ 0
+    /// (the sign of the near root is decided correctly even for grazing directions).
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SphereHit> {
-        let r = self.radius;
-        let f = ray.o;
-        let a = ray.d.length_squared();
-        let b = f.dot(ray.d);
+        let r = self.radius as f64;
+        let f = ray.o.as_dvec3();
+        let d = ray.d.as_dvec3();
+        let a = d.length_squared();
+        let b = f.dot(d);
         let c = f.length_squared() - r * r;
-        let closest = f - (b / a) * ray.d;
+        let closest = f - (b / a) * d;
         let disc = a * (r * r - closest.length_squared());
         if !(disc >= 0.0) {
             return None;
         }
-        let q = -(b + safe_sqrt(disc).copysign(b));
+        let q = -(b + disc.sqrt().copysign(b));
         if q == 0.0 {
             return None;
         }
@@ -102,15 +110,17 @@ impl Sphere {
             (x.min(y), x.max(y))
         };
         for t in [t0, t1] {
-            if !(t > 0.0 && t < t_max) {
+            if !(t > 0.0 && t < t_max as f64) {
                 continue;
             }
+            let t = t as f32;
             let p = self.reproject(ray.at(t));
             if let Some(phi) = self.accepts(p) {
                 return Some(SphereHit {
                     t,
                     p,
-                    n: p / r,
+                    p_error: reprojection_error(p),
+                    n: p / self.radius,
                     uv: self.uv_from(p, phi),
                 });
             }
@@ -166,9 +176,10 @@ impl Sphere {
         let z = self.z_min + u.x * (self.z_max - self.z_min);
         let phi = u.y * self.phi_max;
         let rho = safe_sqrt(self.radius * self.radius - z * z);
-        let p = Vec3::new(rho * phi.cos(), rho * phi.sin(), z);
+        let p = self.reproject(Vec3::new(rho * phi.cos(), rho * phi.sin(), z));
         AreaSample {
             p,
+            p_error: reprojection_error(p),
             n: p / self.radius,
             pdf: 1.0 / self.area(),
         }
@@ -219,6 +230,7 @@ impl Sphere {
         let p = self.reproject(reference + dist * wi);
         Some(SolidAngleSample {
             p,
+            p_error: reprojection_error(p),
             n: p / r,
             wi,
             pdf: 1.0 / (2.0 * PI * omc),
@@ -241,6 +253,13 @@ impl Sphere {
             ),
         }
     }
+}
+
+/// The error bound of a point scaled onto a sphere, p · (r / |p|): the length (a sum of
+/// three squares and a square root), the quotient and the product round about five
+/// times, each relative to |p|'s components.
+fn reprojection_error(p: Vec3) -> Vec3 {
+    super::ray::gamma(5) * p.abs()
 }
 
 #[cfg(test)]

@@ -90,7 +90,35 @@ pub(crate) fn edge_functions_f64(a: [f32; 2], b: [f32; 2], c: [f32; 2]) -> [f32;
     ]
 }
 
-/// Watertight ray–triangle intersection, two-sided. Reports hits with `0 < t < t_max`.
+/// A conservative bound on the rounding error of the computed `t`, from the largest
+/// magnitudes of the sheared vertex coordinates (`max_x`, `max_y`, unscaled `max_z`) and
+/// of the edge functions (`max_e`), and the final factor `sz / det`. A forward error
+/// analysis of the kernel's operations (in the manner of pbrt-v4 §6.8.4, redone for the
+/// unscaled z used here, so that it holds for unnormalised ray directions):
+/// - z = p_z − o_z: one rounding, δz = γ₁ max_z;
+/// - x = (p_x − o_x) − s_x z with |s_x| ≤ 1: |p_x − o_x| ≤ |x| + max_z, three roundings
+///   and the error of z, δx ≤ γ₅ (max_x + 2 max_z) (likewise y);
+/// - e = x_b y_c − y_b x_c: two products and a difference of values carrying δx, δy,
+///   δe ≤ 2 (γ₂ max_x max_y + δy max_x + δx max_y);
+/// - the sum of three products e z: δ ≤ 3 (γ₃ max_e max_z + δe max_z + δz max_e).
+///
+/// When the computed t does not exceed this bound times |sz / det| its sign is not
+/// certain, and the hit is refused: a ray leaving a surface (its origin moved off the
+/// surface past the hit point's error box) cannot find that surface again at t ≈ 0.
+/// Written in the same operation order as the four-lane kernel, so both decide alike.
+#[inline(always)]
+pub(crate) fn t_error_bound(max_x: f32, max_y: f32, max_z: f32, max_e: f32, scale: f32) -> f32 {
+    use super::ray::gamma;
+    let dz = gamma(1) * max_z;
+    let dx = gamma(5) * (max_x + 2.0 * max_z);
+    let dy = gamma(5) * (max_y + 2.0 * max_z);
+    let de = 2.0 * (gamma(2) * max_x * max_y + dy * max_x + dx * max_y);
+    let dt = 3.0 * (gamma(3) * max_e * max_z + de * max_z + dz * max_e);
+    dt * scale.abs()
+}
+
+/// Watertight ray–triangle intersection, two-sided. Reports hits with `0 < t < t_max`
+/// whose t is positive beyond its rounding error ([`t_error_bound`]).
 /// Degenerate (zero-area) triangles and rays in the triangle's plane never hit.
 #[inline]
 pub fn intersect_triangle(
@@ -117,6 +145,14 @@ pub fn intersect_triangle(
     // t = (U Az + V Bz + W Cz) Sz / det up to rounding, with two fewer multiplies.
     let t = (u * a[kz] + v * b[kz] + w * c[kz]) * (ray.sz / det);
     if !(t > 0.0 && t < t_max) {
+        return None;
+    }
+    let [sa, sb, sc] = [shear(a), shear(b), shear(c)];
+    let max_x = sa[0].abs().max(sb[0].abs()).max(sc[0].abs());
+    let max_y = sa[1].abs().max(sb[1].abs()).max(sc[1].abs());
+    let max_z = a[kz].abs().max(b[kz].abs()).max(c[kz].abs());
+    let max_e = u.abs().max(v.abs()).max(w.abs());
+    if !(t > t_error_bound(max_x, max_y, max_z, max_e, ray.sz / det)) {
         return None;
     }
     let inv_det = 1.0 / det;
@@ -146,6 +182,7 @@ pub fn sample_triangle(p0: Vec3, p1: Vec3, p2: Vec3, u: Vec2) -> Option<AreaSamp
     let b = uniform_triangle(u);
     Some(AreaSample {
         p: b[0] * p0 + b[1] * p1 + b[2] * p2,
+        p_error: super::ray::barycentric_error(b, [p0, p1, p2]),
         n: triangle_normal(p0, p1, p2),
         pdf: 1.0 / area,
     })

@@ -109,7 +109,7 @@ pub fn sample_direct(
     let unoccluded = if ls.at_infinity {
         !world.occluded(&hit.spawn_ray(ls.wi), f32::INFINITY)
     } else {
-        world.visible(hit.p, hit.ng, ls.p_light.p, ls.p_light.n)
+        world.visible(&hit.surface_point(), &ls.p_light)
     };
     out.light = unoccluded.then(|| DirectLight {
         f,

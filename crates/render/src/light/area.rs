@@ -5,10 +5,9 @@
 use glam::{Vec2, Vec3};
 
 use super::{LightHit, LightLeSample, LightLiSample, LightPoint, LightSampleContext};
-use crate::geometry::Ray;
 use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
-use crate::geometry::ray::offset_origin;
+use crate::geometry::ray::transform_point_with_error;
 use crate::geometry::sample::{AreaSample, area_pdf_to_solid_angle};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::triangle::sample_triangle;
@@ -81,6 +80,7 @@ impl AreaLight {
                 let s = sample_triangle(p[0], p[1], p[2], u)?;
                 Some(AreaSample {
                     p: s.p,
+                    p_error: s.p_error,
                     n: *n,
                     pdf: 1.0 / area,
                 })
@@ -124,7 +124,7 @@ impl AreaLight {
     /// solid angle.
     pub fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightLiSample> {
         let p = ctx.p;
-        let (q, n, pdf) = match &self.shape {
+        let (p_light, pdf) = match &self.shape {
             LightShape::Sphere {
                 sphere,
                 render_from_object,
@@ -136,13 +136,18 @@ impl AreaLight {
                 if *reverse {
                     n = -n;
                 }
-                (render_from_object.point(s.p), n, s.pdf)
+                let (q, q_error) = transform_point_with_error(render_from_object, s.p, s.p_error);
+                (LightPoint::new(q, q_error, n), s.pdf)
             }
             _ => {
                 let s = self.sample_area(u)?;
-                (s.p, s.n, area_pdf_to_solid_angle(s.pdf, p, s.p, s.n))
+                (
+                    LightPoint::new(s.p, s.p_error, s.n),
+                    area_pdf_to_solid_angle(s.pdf, p, s.p, s.n),
+                )
             }
         };
+        let (q, n) = (p_light.p, p_light.n);
         if pdf <= 0.0 || !pdf.is_finite() {
             return None;
         }
@@ -155,7 +160,7 @@ impl AreaLight {
             li,
             wi,
             pdf,
-            p_light: LightPoint { p: q, n },
+            p_light,
             delta: false,
             at_infinity: false,
         })
@@ -203,7 +208,7 @@ impl AreaLight {
         let local = sampling::cosine_hemisphere(u);
         let d = Frame::from_normal(n).to_world(local);
         Some(LightLeSample {
-            ray: Ray::new(offset_origin(s.p, n, d), d),
+            ray: LightPoint::new(s.p, s.p_error, n).spawn_ray(d),
             n,
             pdf_pos: s.pdf,
             pdf_dir: sampling::cosine_hemisphere_pdf(local.z) / sides,
@@ -226,8 +231,10 @@ fn to_render(s: AreaSample, xf: &Transform, reverse: bool, scale2: f32) -> AreaS
     if reverse {
         n = -n;
     }
+    let (p, p_error) = transform_point_with_error(xf, s.p, s.p_error);
     AreaSample {
-        p: xf.point(s.p),
+        p,
+        p_error,
         n,
         pdf: s.pdf / scale2,
     }

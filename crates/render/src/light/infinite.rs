@@ -26,10 +26,7 @@ pub(super) fn sample_li(
         li: radiance,
         wi,
         pdf: pdf_li(wi),
-        p_light: LightPoint {
-            p: p + wi * (2.0 * scene.radius + (p - scene.center).length()),
-            n: Vec3::ZERO,
-        },
+        p_light: LightPoint::free(p + wi * (2.0 * scene.radius + (p - scene.center).length())),
         delta: false,
         at_infinity: true,
     })

@@ -55,14 +55,10 @@ impl LightSampleContext {
     }
 }
 
-/// A point on a light: where a shadow ray towards it ends.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LightPoint {
-    pub p: Vec3,
-    /// Surface normal at `p`; zero for lights without a surface (the shadow ray then
-    /// ends at `p` itself, not at a point offset off a surface).
-    pub n: Vec3,
-}
+/// A point on a light: where a shadow ray towards it ends, with the error bound of its
+/// position and its surface normal (zero for lights without a surface: the shadow ray then
+/// ends at `p` itself, not at a point moved off a surface).
+pub type LightPoint = crate::geometry::SurfacePoint;
 
 /// Where a ray from a receiver met a light's surface: what `pdf_li` needs to give the
 /// density of that direction (a surface hit makes one by `SurfaceHit::light_hit`).
@@ -223,10 +219,9 @@ impl Light {
                 li: *radiance,
                 wi: -*direction,
                 pdf: 1.0,
-                p_light: LightPoint {
-                    p: p - *direction * (2.0 * scene.radius + (p - scene.center).length()),
-                    n: Vec3::ZERO,
-                },
+                p_light: LightPoint::free(
+                    p - *direction * (2.0 * scene.radius + (p - scene.center).length()),
+                ),
                 delta: true,
                 at_infinity: true,
             }),

@@ -17,10 +17,7 @@ pub(super) fn sample_point(p: Vec3, position: Vec3, intensity: Rgb) -> Option<Li
         li: intensity / dist2,
         wi: d / dist2.sqrt(),
         pdf: 1.0,
-        p_light: LightPoint {
-            p: position,
-            n: Vec3::ZERO,
-        },
+        p_light: LightPoint::free(position),
         delta: true,
         at_infinity: false,
     })

@@ -12,8 +12,7 @@ use glam::{Vec2, Vec3};
 pub use build::BuildError;
 pub use shapes::ShapeSet;
 
-use crate::geometry::ray::offset_origin;
-use crate::geometry::{Aabb, Ray};
+use crate::geometry::{Aabb, Ray, SurfacePoint};
 use crate::light::{Light, LightHit, LightSampleContext, LightSampler};
 use crate::material::Material;
 
@@ -26,6 +25,9 @@ pub struct SurfaceHit {
     /// Ray parameter of the hit.
     pub t: f32,
     pub p: Vec3,
+    /// Conservative bound on the rounding error of `p`, per component: rays leaving the
+    /// surface start outside this box.
+    pub p_error: Vec3,
     /// Unit geometric normal, oriented as the shape's (emitting) front side.
     pub ng: Vec3,
     /// Unit shading normal, on the same side as `ng`.
@@ -37,13 +39,19 @@ pub struct SurfaceHit {
 }
 
 impl SurfaceHit {
-    /// Origin for a ray leaving the surface towards `w`, offset off the surface.
+    /// The hit as a place rays start from: position, error bound, geometric normal.
+    pub fn surface_point(&self) -> SurfacePoint {
+        SurfacePoint::new(self.p, self.p_error, self.ng)
+    }
+
+    /// Origin for a ray leaving the surface towards `w`, moved off the surface past the
+    /// hit point's error bound.
     pub fn spawn_origin(&self, w: Vec3) -> Vec3 {
-        offset_origin(self.p, self.ng, w)
+        self.surface_point().spawn_origin(w)
     }
 
     pub fn spawn_ray(&self, w: Vec3) -> Ray {
-        Ray::new(self.spawn_origin(w), w)
+        self.surface_point().spawn_ray(w)
     }
 
     /// This point as a receiver of light sampling.
@@ -88,17 +96,11 @@ impl World {
         self.geometry.occluded(ray, t_max, &self.prototypes)
     }
 
-    /// True when the segment from a surface point (offset along its normal `n0`) to `p1`
-    /// is free; `n1` is the normal at `p1` (zero for points in free space).
-    pub fn visible(&self, p0: Vec3, n0: Vec3, p1: Vec3, n1: Vec3) -> bool {
-        let o = offset_origin(p0, n0, p1 - p0);
-        let target = if n1 == Vec3::ZERO {
-            p1
-        } else {
-            offset_origin(p1, n1, o - p1)
-        };
-        let d = target - o;
-        !self.occluded(&Ray::new(o, d), 1.0 - 1e-4)
+    /// True when the segment between two points is free: each end is moved off its own
+    /// surface (by its error bound, towards the other) and the far end is not counted.
+    pub fn visible(&self, from: &SurfacePoint, to: &SurfacePoint) -> bool {
+        let (ray, t_max) = from.spawn_ray_to(to);
+        !self.occluded(&ray, t_max)
     }
 
     /// Bounding spheres (centre, radius) of the specular geometry (mirrors, conductors,

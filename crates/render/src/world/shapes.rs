@@ -6,6 +6,7 @@ use super::{NO_LIGHT, SurfaceHit};
 use crate::accel::{Bvh, TriangleBvh};
 use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
+use crate::geometry::ray::{barycentric_error, transform_point_with_error};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::{Aabb, Ray};
 use radiant_math::Transform;
@@ -98,6 +99,7 @@ enum RawHit {
     Quadric {
         prim: PrimRef,
         p_obj: Vec3,
+        p_error: Vec3,
         n_obj: Vec3,
         uv: Vec2,
     },
@@ -253,6 +255,7 @@ impl ShapeSet {
                         RawHit::Quadric {
                             prim: PrimRef::Sphere(i),
                             p_obj: h.p,
+                            p_error: h.p_error,
                             n_obj: h.n,
                             uv: h.uv,
                         },
@@ -269,6 +272,8 @@ impl ShapeSet {
                         RawHit::Quadric {
                             prim: PrimRef::Disk(i),
                             p_obj: h.p,
+                            // Exactly in the disk's plane.
+                            p_error: Vec3::ZERO,
                             n_obj: Vec3::Z,
                             uv: h.uv,
                         },
@@ -281,7 +286,8 @@ impl ShapeSet {
                     quadric = Some((
                         RawHit::Quadric {
                             prim: PrimRef::Bilinear(i),
-                            p_obj: ray.at(h.t),
+                            p_obj: h.p,
+                            p_error: h.p_error,
                             n_obj: h.n,
                             uv: h.uv,
                         },
@@ -317,7 +323,7 @@ impl ShapeSet {
                 let inst = &self.instances[i as usize];
                 let mut hit = prototypes[inst.prototype as usize].surface_hit(t, raw);
                 let to_render = &inst.render_from_instance;
-                hit.p = to_render.point(hit.p);
+                (hit.p, hit.p_error) = transform_point_with_error(to_render, hit.p, hit.p_error);
                 hit.ng = to_render.normal(hit.ng).normalize();
                 hit.ns = to_render.normal(hit.ns).normalize();
                 Some(hit)
@@ -363,6 +369,7 @@ impl ShapeSet {
             RawHit::Quadric {
                 prim: PrimRef::Bilinear(i),
                 p_obj,
+                p_error,
                 n_obj,
                 uv,
             } => {
@@ -371,6 +378,7 @@ impl ShapeSet {
                 SurfaceHit {
                     t,
                     p: p_obj,
+                    p_error,
                     ng: n,
                     ns: n,
                     uv,
@@ -381,6 +389,7 @@ impl ShapeSet {
             RawHit::Quadric {
                 prim,
                 p_obj,
+                p_error,
                 n_obj,
                 uv,
             } => {
@@ -399,9 +408,11 @@ impl ShapeSet {
                 if reverse {
                     n = -n;
                 }
+                let (p, p_error) = transform_point_with_error(xf, p_obj, p_error);
                 SurfaceHit {
                     t,
-                    p: xf.point(p_obj),
+                    p,
+                    p_error,
                     ng: n,
                     ns: n,
                     uv,
@@ -416,6 +427,7 @@ impl ShapeSet {
         let [p0, p1, p2] = self.triangles[index as usize];
         let attr = self.triangle_attrs[index as usize];
         let p = b[0] * p0 + b[1] * p1 + b[2] * p2;
+        let p_error = barycentric_error(b, [p0, p1, p2]);
         let mut ng = (p1 - p0).cross(p2 - p0).normalize_or_zero() * attr.orientation;
         let mesh = &self.meshes[attr.mesh as usize];
         let tri = 3 * attr.index as usize;
@@ -445,6 +457,7 @@ impl ShapeSet {
         SurfaceHit {
             t,
             p,
+            p_error,
             ng,
             ns,
             uv,
