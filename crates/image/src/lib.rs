@@ -12,6 +12,7 @@ pub mod flip;
 pub mod metrics;
 pub mod pfm;
 pub mod png;
+pub mod tiles;
 #[cfg(test)]
 mod reference_tests;
 
@@ -23,6 +24,7 @@ pub use error::ImageError;
 pub use film::{Film, FilmPixel, NonFinite, Sensor};
 pub use filter::{Filter, FilterSample};
 pub use metrics::{Metrics, compare};
+pub use tiles::{TileComparison, TileCriterion, TileStats, compare_tiles};
 
 /// A linear RGB image, row-major, row 0 at the top (pixel (0,0) is top-left).
 #[derive(Clone, Debug, PartialEq)]

@@ -2,6 +2,8 @@
 //! [`Session`], and the images it renders. The solver's own tests (meshing, factors,
 //! solvers, exports) are in crates/radiosity/tests.
 
+mod common;
+
 use std::ops::ControlFlow;
 
 use radiant::Session;
@@ -172,4 +174,131 @@ fn refined_render_runs_through_the_session() {
     )
     .unwrap();
     assert!(solved.scene.is_none() && solved.passes == 0);
+}
+
+/// The path tracer against radiosity with final gather on the diffuse Cornell box from
+/// three views, tile by tile: the standard camera, one outside the open front looking in
+/// obliquely at the right wall, and one inside near the ceiling looking down into the
+/// far corner.
+///
+/// Both images are means of four independent passes, so each tile's standard error is
+/// measured for both (`radiant::image::tiles`) and SE² = SE²_path + SE²_radiosity. The
+/// final gather evaluates emission and direct light exactly as the path tracer does
+/// (light sampling, shadow rays) and reads the solved radiosity only one bounce away,
+/// so the discretization error of constant patches is averaged over each gather's
+/// hemisphere: what is left is a smooth bias of the indirect part, bounded by the
+/// relative floor (measured below). One solve serves every view and pass.
+#[test]
+fn path_tracer_matches_radiosity_final_gather_tile_by_tile() {
+    use glam::Vec3;
+    use radiant::image::tiles::{TileCriterion, TileStats, compare_tiles};
+    use radiant::radiosity::output::shading::Shading;
+    use radiant::radiosity::integrator::solve_session;
+    use radiant::render::integrator::render_passes;
+    use radiant::render::{Overrides, Progress, RenderContext, RenderControl};
+    use radiant::scene::ParamValue;
+    use radiant_testkit::fixtures::{with_camera, with_resolution};
+
+    const RES: u32 = 128;
+    const TILE: usize = 8;
+    const PASSES: u64 = 4;
+    const PATH_SPP: u32 = 128;
+    const GATHER_SPP: u32 = 8;
+    let criterion = TileCriterion {
+        k: 4.0,
+        rel_floor: 0.01,
+    };
+
+    let mut desc = with_resolution(cornell_box(), RES, RES);
+    desc.integrator.name = "radiosity".into();
+    desc.integrator.params = radiant::scene::ParamSet::new()
+        .with("maxpatcharea", ParamValue::Float(vec![600.0]))
+        .with("finalgather", ParamValue::Int(vec![32]))
+        .with("tolerance", ParamValue::Float(vec![1e-3]));
+    let session = Session::new(&desc, &Overrides::default()).unwrap();
+    let rad = session
+        .integrator_as::<RadiosityIntegrator>()
+        .expect("radiosity");
+    let start = std::time::Instant::now();
+    let solved = solve_session(
+        &session.ctx.world,
+        &rad.scene,
+        &rad.settings,
+        &Progress::default(),
+    );
+    let scene = solved.scene(&rad.scene);
+    let display = solved.solution.display_radiosity(&scene.patches);
+    let shading = Shading::new(
+        scene,
+        &session.ctx.world,
+        &display,
+        &solved.solution.irradiance,
+        rad.settings.final_gather,
+    )
+    .with_specular_depth(rad.settings.max_depth);
+    eprintln!(
+        "radiosity: {} patches, solved in {:.1} s",
+        scene.patches.len(),
+        start.elapsed().as_secs_f64()
+    );
+
+    let views = [
+        ("standard", cornell_box().camera),
+        (
+            "outside-oblique",
+            with_camera(
+                cornell_box(),
+                Vec3::new(520.0, 420.0, -600.0),
+                Vec3::new(150.0, 230.0, 330.0),
+                40.0,
+            )
+            .camera,
+        ),
+        (
+            "inside-corner",
+            with_camera(
+                cornell_box(),
+                Vec3::new(480.0, 470.0, 120.0),
+                Vec3::new(80.0, 120.0, 500.0),
+                70.0,
+            )
+            .camera,
+        ),
+    ];
+    let mut failures = Vec::new();
+    for (name, camera) in views {
+        let mut view = cornell_box();
+        view.camera = camera;
+        let view = with_resolution(view, RES, RES);
+        let t0 = std::time::Instant::now();
+        let path = common::render_passes(&view, PATH_SPP, PASSES);
+        let t1 = std::time::Instant::now();
+        let gathered: Vec<_> = (1..=PASSES)
+            .map(|seed| {
+                let overrides = Overrides {
+                    spp: Some(GATHER_SPP),
+                    seed: Some(seed),
+                    ..Overrides::default()
+                };
+                let (ctx, _) = RenderContext::new(&view, &overrides).unwrap();
+                let progress = Progress::default();
+                let mut no_snapshots = |_: u32, _: &radiant::image::Film| {};
+                let mut control = RenderControl::new(&progress, &mut no_snapshots);
+                render_passes(&ctx, &shading, &mut control).film.image()
+            })
+            .collect();
+        eprintln!(
+            "{name}: path {:.1} s, radiosity gather {:.1} s",
+            (t1 - t0).as_secs_f64(),
+            t1.elapsed().as_secs_f64()
+        );
+        let (p, path_mean) = TileStats::from_passes(&path, TILE).unwrap();
+        let (g, _) = TileStats::from_passes(&gathered, TILE).unwrap();
+        let cmp = compare_tiles(&p, &g, criterion, &|_, _| false).unwrap();
+        let label = format!("path-vs-radiosity-{name}");
+        if let Err(e) = common::check_tiles(&label, &cmp, &path_mean) {
+            failures.push(e);
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
