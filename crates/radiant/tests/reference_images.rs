@@ -36,6 +36,7 @@ const SPP: u32 = 1024;
 const CRITERION: TileCriterion = TileCriterion {
     k: 4.0,
     rel_floor: 0.003,
+    abs_floor: 0.0,
 };
 
 /// Mean over pixels and channels of the passes' variance of their mean: (absolute,
@@ -63,10 +64,9 @@ fn check_against_reference(scene: &str, mask: &dyn Fn(&Image) -> Vec<bool>) {
     let reference = read_image(common::shared(&format!("refs/{scene}-256-ref.exr"))).unwrap();
     let noise = |key| common::noise_figure(&format!("refs/{scene}-256-ref.noise.txt"), key);
     let (ref_relmse, ref_rmse) = (noise("ref_relmse_est"), noise("ref_rmse_est"));
-    let desc = radiant::scene::parse_file(&radiant_testkit::repo_path(&format!(
-        "scenes/{scene}.pbrt"
-    )))
-    .unwrap();
+    let desc =
+        radiant::scene::parse_file(&radiant_testkit::repo_path(&format!("scenes/{scene}.pbrt")))
+            .unwrap();
     let masked = mask(&reference);
     let start = std::time::Instant::now();
     let passes = common::render_passes(&desc, SPP / PASSES as u32, PASSES);
@@ -132,7 +132,9 @@ fn caustic_tiles(reference: &Image) -> Vec<bool> {
         for x in 0..w {
             window.clear();
             for wy in y.saturating_sub(R)..(y + R + 1).min(h) {
-                window.extend_from_slice(&lum[wy * w + x.saturating_sub(R)..wy * w + (x + R + 1).min(w)]);
+                window.extend_from_slice(
+                    &lum[wy * w + x.saturating_sub(R)..wy * w + (x + R + 1).min(w)],
+                );
             }
             let mid = window.len() / 2;
             let median = *window.select_nth_unstable_by(mid, f32::total_cmp).1;
@@ -154,7 +156,11 @@ fn caustic_tiles(reference: &Image) -> Vec<bool> {
         }
     }
     let rows: Vec<String> = (0..ny)
-        .map(|ty| (0..nx).map(|tx| if mask[ty * nx + tx] { '#' } else { '.' }).collect())
+        .map(|ty| {
+            (0..nx)
+                .map(|tx| if mask[ty * nx + tx] { '#' } else { '.' })
+                .collect()
+        })
         .collect();
     eprintln!("caustic tiles (#):\n{}", rows.join("\n"));
     mask

@@ -80,6 +80,8 @@ pub fn check_tiles(
     radiant::image::write_image(&map, &cmp.z_map(), &meta, 0.0).expect("write tile map");
     let image = dir.join(format!("{name}-test.exr"));
     radiant::image::write_image(&image, test, &meta, 0.0).expect("write test image");
+    radiant::image::write_image(image.with_extension("png"), test, &meta, 1.0)
+        .expect("write test image");
     Err(format!(
         "{name}: tiles outside the bound (map: {}, image: {})\n{table}",
         map.display(),
