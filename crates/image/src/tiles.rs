@@ -447,7 +447,7 @@ mod tests {
         };
         let passes = |seed: u64, bias: &dyn Fn(usize, usize) -> f64| {
             (0..4)
-                .map(|s| noisy(128, 128, 0.2, seed * 10 + s, bias))
+                .map(|s| noisy(128, 128, 0.05, seed * 10 + s, bias))
                 .collect::<Vec<_>>()
         };
         let (a, _) = TileStats::from_passes(&passes(1, &|_, _| 0.0), 16).unwrap();
