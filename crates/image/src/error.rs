@@ -62,6 +62,14 @@ pub enum ImageError {
         height: usize,
     },
 
+    /// A noise estimate from independent passes needs at least two.
+    #[error("{got} pass(es) given; the spread between passes needs at least 2")]
+    TooFewPasses { got: usize },
+
+    /// Tile statistics on different tile grids cannot be compared.
+    #[error("tile grids differ: {a} px tiles vs {b} px tiles")]
+    TileMismatch { a: usize, b: usize },
+
     /// An image with zero width or height, or with a pixel buffer of the wrong length.
     #[error("{path}: invalid image: {message}", path = path.display())]
     InvalidImage { path: PathBuf, message: String },

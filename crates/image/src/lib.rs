@@ -15,6 +15,7 @@ pub mod pfm;
 pub mod png;
 #[cfg(test)]
 mod reference_tests;
+pub mod tiles;
 
 use std::path::Path;
 
@@ -24,6 +25,7 @@ pub use error::ImageError;
 pub use film::{Film, FilmPixel, NonFinite, Sensor};
 pub use filter::{Filter, FilterSample};
 pub use metrics::{Metrics, compare};
+pub use tiles::{TileComparison, TileCriterion, TileStats, compare_tiles};
 
 /// A linear RGB image, row-major, row 0 at the top (pixel (0,0) is top-left).
 #[derive(Clone, Debug, PartialEq)]

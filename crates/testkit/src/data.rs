@@ -35,3 +35,16 @@ pub fn shared(rel: &str) -> PathBuf {
     );
     p
 }
+
+/// A folder for what a test writes for inspection (difference maps of failed
+/// comparisons): `$CARGO_TARGET_DIR/test-output/<name>`, or `target/test-output/<name>`
+/// in the repository. Created if missing.
+pub fn output_dir(name: &str) -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| repo_root().join("target"));
+    let dir = target.join("test-output").join(name);
+    std::fs::create_dir_all(&dir)
+        .unwrap_or_else(|e| panic!("cannot create {}: {e}", dir.display()));
+    dir
+}

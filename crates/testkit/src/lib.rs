@@ -8,4 +8,4 @@ pub mod chi2;
 pub mod data;
 pub mod fixtures;
 
-pub use data::{repo_path, shared, shared_root};
+pub use data::{output_dir, repo_path, shared, shared_root};

@@ -44,3 +44,54 @@ pub fn concrete<T: radiant::render::Integrator>(i: &dyn radiant::render::Integra
     any.downcast_ref::<T>()
         .unwrap_or_else(|| panic!("{} is not the integrator expected", i.name()))
 }
+
+/// `passes` renders of a scene with seeds `1..=passes`, `spp` samples each: independent
+/// images whose spread measures the noise of their mean (see `radiant::image::tiles`).
+pub fn render_passes(desc: &SceneDesc, spp: u32, passes: u64) -> Vec<Image> {
+    (1..=passes)
+        .map(|seed| {
+            render(
+                desc,
+                &Overrides {
+                    spp: Some(spp),
+                    seed: Some(seed),
+                    ..Default::default()
+                },
+            )
+        })
+        .collect()
+}
+
+/// Prints a tile comparison's worst tiles; when any tile fails, writes the tile-z map
+/// and the test image to `target/test-output/tiles/<name>-*` and returns the table.
+pub fn check_tiles(
+    name: &str,
+    cmp: &radiant::image::TileComparison,
+    test: &Image,
+) -> Result<(), String> {
+    let table = cmp.report(12);
+    eprintln!("{name}: {table}");
+    if cmp.failures().is_empty() {
+        return Ok(());
+    }
+    let dir = radiant_testkit::output_dir("tiles");
+    let map = dir.join(format!("{name}-tile-z.png"));
+    let meta = radiant::image::ImageMeta::default();
+    radiant::image::write_image(&map, &cmp.z_map(), &meta, 0.0).expect("write tile map");
+    let image = dir.join(format!("{name}-test.exr"));
+    radiant::image::write_image(&image, test, &meta, 0.0).expect("write test image");
+    radiant::image::write_image(image.with_extension("png"), test, &meta, 1.0)
+        .expect("write test image");
+    Err(format!(
+        "{name}: tiles outside the bound (map: {}, image: {})\n{table}",
+        map.display(),
+        image.display()
+    ))
+}
+
+/// [`check_tiles`], panicking with the table on failure.
+pub fn assert_tiles(name: &str, cmp: &radiant::image::TileComparison, test: &Image) {
+    if let Err(e) = check_tiles(name, cmp, test) {
+        panic!("{e}");
+    }
+}
