@@ -10,7 +10,9 @@ use super::record::FIRST_DIFFUSE;
 use super::settings::Visualize;
 use super::{PhotonMaps, facing};
 use crate::geometry::Ray;
-use crate::integrator::direct::{ShadingPoint, environment, sample_direct, surface_emission};
+use crate::integrator::direct::{
+    ShadingPoint, environment, sample_direct, sides_agree, surface_emission,
+};
 use crate::integrator::specular::specular_bounce;
 use crate::light::SceneSphere;
 use crate::material::TransportMode;
@@ -190,7 +192,7 @@ fn final_gather(
             continue;
         };
         let wi = frame.to_world(bs.wi);
-        if !bs.specular && wi.dot(x.ng) * wo_world.dot(x.ng) <= 0.0 {
+        if !bs.specular && !sides_agree(x, wo_world, wi, wo, bs.wi) {
             continue;
         }
         let mut beta = bs.f * (bs.wi.z.abs() / bs.pdf);

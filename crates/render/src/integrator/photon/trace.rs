@@ -149,7 +149,7 @@ pub fn trace_photon(
         };
         let wi_world = frame.to_world(bs.wi);
         let (wo_ng, wi_ng) = (wo_world.dot(hit.ng), wi_world.dot(hit.ng));
-        if !bs.specular && wo_ng * wi_ng <= 0.0 {
+        if !bs.specular && (wo_ng * wi_ng > 0.0) != (wo.z * bs.wi.z > 0.0) {
             break;
         }
         let mut weight = bs.f * (bs.wi.z.abs() / bs.pdf);
