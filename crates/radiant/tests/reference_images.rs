@@ -134,7 +134,10 @@ fn worst_tile_z(a: &[f64], b: &[f64], reference: &[f64], ref_rmse: f64) -> f64 {
             // The floor keeps tiles that are black in every image at z = 0.
             let z = (d / n).abs() / (sigma + 1e-6);
             if z > 3.5 {
-                eprintln!("tile ({tx}, {ty}): difference {:.5}, sigma {sigma:.5}, z {z:.2}", d / n);
+                eprintln!(
+                    "tile ({tx}, {ty}): difference {:.5}, sigma {sigma:.5}, z {z:.2}",
+                    d / n
+                );
             }
             worst = worst.max(z);
         }
@@ -163,8 +166,10 @@ fn check_materials_scene(variant: &str, spp: u32) {
         .filter(|w| w.message.contains("not supported"))
         .collect();
     assert!(unsupported.is_empty(), "{unsupported:?}");
-    let reference =
-        read_image(common::shared(&format!("refs/materials/{scene}-256-ref.exr"))).unwrap();
+    let reference = read_image(common::shared(&format!(
+        "refs/materials/{scene}-256-ref.exr"
+    )))
+    .unwrap();
     let noise = format!("refs/materials/{scene}-256-ref.noise.txt");
     let ref_relmse = common::noise_figure(&noise, "ref_relmse_est");
     let ref_rmse = common::noise_figure(&noise, "ref_rmse_est");
@@ -190,13 +195,26 @@ fn check_materials_scene(variant: &str, spp: u32) {
         "{scene} @ {spp} spp: relMSE vs ref {:.3e}, own noise {own:.3e}, ref noise {ref_relmse:.3e}, limit {limit:.3e}; mean {mean_both:.6} vs {:.6}",
         m.relmse, m.mean_ref
     );
-    assert!(m.relmse <= limit, "{scene}: relMSE {} above {limit}", m.relmse);
+    assert!(
+        m.relmse <= limit,
+        "{scene}: relMSE {} above {limit}",
+        m.relmse
+    );
     let rel = (mean_both - m.mean_ref).abs() / m.mean_ref;
-    assert!(rel < 0.005, "{scene}: mean {mean_both} vs {} ({:.3} %)", m.mean_ref, 100.0 * rel);
+    assert!(
+        rel < 0.005,
+        "{scene}: mean {mean_both} vs {} ({:.3} %)",
+        m.mean_ref,
+        100.0 * rel
+    );
 
     let (base_a, base_b) = (run(&base_desc, 1), run(&base_desc, 2));
     let minus = |x: &Image, y: &Image| -> Vec<f64> {
-        luminance(x).iter().zip(luminance(y)).map(|(p, q)| p - q).collect()
+        luminance(x)
+            .iter()
+            .zip(luminance(y))
+            .map(|(p, q)| p - q)
+            .collect()
     };
     let z = worst_tile_z(
         &minus(&a, &base_a),
@@ -207,7 +225,10 @@ fn check_materials_scene(variant: &str, spp: u32) {
     eprintln!("{scene}: worst tile of the material change {z:.2} sigma");
     // 256 tiles of a heavy-tailed (caustic) estimate: 5.5 σ keeps correct code from
     // failing by chance while a 1 % bias of a bright tile still stands out at 512 spp.
-    assert!(z < 5.5, "{scene}: a tile of the material change is {z:.2} sigma off");
+    assert!(
+        z < 5.5,
+        "{scene}: a tile of the material change is {z:.2} sigma off"
+    );
 }
 
 #[test]

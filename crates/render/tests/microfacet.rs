@@ -122,11 +122,31 @@ fn rough_dielectric_sampling_matches_its_pdf_from_both_sides() {
     // From inside, cos 0.6 lies beyond the critical angle of eta 1.5 (cos 0.745):
     // rough total internal reflection.
     let wos = [
-        ("outside, near normal", direction(0.9, 0.4), TransportMode::Radiance),
-        ("outside, grazing", direction(0.05, 1.0), TransportMode::Importance),
-        ("inside, near normal", -direction(0.95, 2.5), TransportMode::Radiance),
-        ("inside, beyond critical", -direction(0.6, 3.5), TransportMode::Importance),
-        ("inside, grazing", -direction(0.08, 5.0), TransportMode::Radiance),
+        (
+            "outside, near normal",
+            direction(0.9, 0.4),
+            TransportMode::Radiance,
+        ),
+        (
+            "outside, grazing",
+            direction(0.05, 1.0),
+            TransportMode::Importance,
+        ),
+        (
+            "inside, near normal",
+            -direction(0.95, 2.5),
+            TransportMode::Radiance,
+        ),
+        (
+            "inside, beyond critical",
+            -direction(0.6, 3.5),
+            TransportMode::Importance,
+        ),
+        (
+            "inside, grazing",
+            -direction(0.08, 5.0),
+            TransportMode::Radiance,
+        ),
     ];
     let mut seed = 100;
     for (ax, ay) in ALPHAS {
@@ -176,21 +196,48 @@ fn sampled_albedo(material: &Material, wo: Vec3, mode: TransportMode, n: u32) ->
 #[test]
 fn albedo_is_at_most_one_and_equals_the_integral_of_f_cos() {
     let cases = [
-        ("conductor copper 0.3", conductor(0.3, 0.3, copper()), direction(0.7, 0.3)),
-        ("conductor white 0.5", conductor(0.5, 0.5, ConductorFresnel::Constant(Rgb::WHITE)), direction(0.2, 1.0)),
-        ("conductor white 0.05/0.4", conductor(0.05, 0.4, ConductorFresnel::Constant(Rgb::WHITE)), direction(0.6, 0.8)),
-        ("dielectric 0.3 outside", dielectric(0.3, 0.3, 1.5), direction(0.8, 0.2)),
-        ("dielectric 0.6 outside grazing", dielectric(0.6, 0.6, 1.5), direction(0.1, 2.2)),
-        ("dielectric 0.3 inside", dielectric(0.3, 0.3, 1.5), -direction(0.9, 1.2)),
-        ("dielectric 0.5/0.1 inside", dielectric(0.5, 0.1, 1.33), -direction(0.5, 4.0)),
+        (
+            "conductor copper 0.3",
+            conductor(0.3, 0.3, copper()),
+            direction(0.7, 0.3),
+        ),
+        (
+            "conductor white 0.5",
+            conductor(0.5, 0.5, ConductorFresnel::Constant(Rgb::WHITE)),
+            direction(0.2, 1.0),
+        ),
+        (
+            "conductor white 0.05/0.4",
+            conductor(0.05, 0.4, ConductorFresnel::Constant(Rgb::WHITE)),
+            direction(0.6, 0.8),
+        ),
+        (
+            "dielectric 0.3 outside",
+            dielectric(0.3, 0.3, 1.5),
+            direction(0.8, 0.2),
+        ),
+        (
+            "dielectric 0.6 outside grazing",
+            dielectric(0.6, 0.6, 1.5),
+            direction(0.1, 2.2),
+        ),
+        (
+            "dielectric 0.3 inside",
+            dielectric(0.3, 0.3, 1.5),
+            -direction(0.9, 1.2),
+        ),
+        (
+            "dielectric 0.5/0.1 inside",
+            dielectric(0.5, 0.1, 1.33),
+            -direction(0.5, 4.0),
+        ),
     ];
     for (name, m, wo) in cases {
         // Importance transport: the albedo is the fraction of power scattered, which
         // a passive surface keeps at or below 1 (radiance picks up η² on refraction).
         let mode = TransportMode::Importance;
-        let integral = sphere_integral(1500, |wi| {
-            (m.eval_mode(wo, wi, mode).g * wi.z.abs()) as f64
-        });
+        let integral =
+            sphere_integral(1500, |wi| (m.eval_mode(wo, wi, mode).g * wi.z.abs()) as f64);
         let (mc, se) = sampled_albedo(&m, wo, mode, 400_000);
         println!("{name}: quadrature {integral:.5}, sampled {mc:.5} ± {se:.5}");
         assert!(mc <= 1.0 + 4.0 * se && integral <= 1.0 + 1e-3, "{name}");
@@ -225,7 +272,11 @@ fn white_rough_conductor_loses_only_single_scattering_energy() {
     for alpha in [0.05f32, 0.2, 0.5, 1.0] {
         let d = TrowbridgeReitz::new(alpha, alpha);
         let m = conductor(alpha, alpha, white);
-        for wo in [direction(1.0, 0.0), direction(0.5, 1.0), direction(0.15, 2.0)] {
+        for wo in [
+            direction(1.0, 0.0),
+            direction(0.5, 1.0),
+            direction(0.15, 2.0),
+        ] {
             let expected = white_albedo_over_normals(&d, wo);
             let integral = sphere_integral(1500, |wi| (m.eval(wo, wi).g * wi.z.max(0.0)) as f64);
             let (mc, se) = sampled_albedo(&m, wo, TransportMode::Radiance, 200_000);
@@ -235,7 +286,10 @@ fn white_rough_conductor_loses_only_single_scattering_energy() {
             );
             assert!(expected <= 1.0 && expected > 0.3);
             assert!((integral - expected).abs() < 3e-3, "alpha {alpha} wo {wo}");
-            assert!((mc - expected).abs() < 4.0 * se + 1e-3, "alpha {alpha} wo {wo}");
+            assert!(
+                (mc - expected).abs() < 4.0 * se + 1e-3,
+                "alpha {alpha} wo {wo}"
+            );
             if wo.z == 1.0 {
                 // The loss (multiple scattering left out) grows with roughness and
                 // vanishes for a smooth surface.
@@ -279,7 +333,10 @@ fn reciprocity_and_the_eta_squared_rule() {
             continue;
         }
         let (a, b) = (c.eval(wo, wi), c.eval(wi, wo));
-        assert!(rel_close(a.r, b.r, 1e-4) && rel_close(a.b, b.b, 1e-4), "{wo} {wi}");
+        assert!(
+            rel_close(a.r, b.r, 1e-4) && rel_close(a.b, b.b, 1e-4),
+            "{wo} {wi}"
+        );
         let fwd = g.eval_mode(wo, wi, TransportMode::Radiance).g;
         let rev = g.eval_mode(wi, wo, TransportMode::Radiance).g;
         // Adjoint: importance transport is radiance transport with the roles swapped.
@@ -308,7 +365,10 @@ fn reciprocity_and_the_eta_squared_rule() {
             transmissions += (fwd > 0.0) as u32;
         }
     }
-    assert!(reflections > 1000 && transmissions > 1000, "{reflections} {transmissions}");
+    assert!(
+        reflections > 1000 && transmissions > 1000,
+        "{reflections} {transmissions}"
+    );
 }
 
 #[test]
@@ -349,7 +409,10 @@ fn tiny_alpha_stays_a_delta_and_approaches_the_smooth_bsdf() {
     assert!(lost < 20, "{lost} of {n} samples lost");
     let r = fresnel::dielectric(0.6, 1.5) as f64;
     let p = reflected as f64 / n as f64;
-    assert!((p - r).abs() < 4.0 * (r * (1.0 - r) / n as f64).sqrt() + 2e-3, "{p} vs {r}");
+    assert!(
+        (p - r).abs() < 4.0 * (r * (1.0 - r) / n as f64).sqrt() + 2e-3,
+        "{p} vs {r}"
+    );
 }
 
 #[test]
@@ -359,4 +422,3 @@ fn reflectance_conductor_has_that_reflectance_at_normal_incidence() {
     assert!((r.r - 0.1).abs() < 1e-4 && (r.g - 0.5).abs() < 1e-4 && (r.b - 0.95).abs() < 1e-4);
     assert!(fr.eval(0.05).r > r.r);
 }
-

@@ -143,7 +143,11 @@ pub enum MaterialDesc {
     /// Rough dielectric (Trowbridge–Reitz microfacets): relative index `eta` and the
     /// distribution's alpha along the surface's two tangent axes (already remapped
     /// from pbrt's `roughness` when `remaproughness` is true).
-    RoughDielectric { eta: f32, alpha_u: f32, alpha_v: f32 },
+    RoughDielectric {
+        eta: f32,
+        alpha_u: f32,
+        alpha_v: f32,
+    },
     /// Rough conductor (Trowbridge–Reitz microfacets) with the Fresnel term of
     /// `conductor` and alphas as for [`MaterialDesc::RoughDielectric`].
     RoughConductor {

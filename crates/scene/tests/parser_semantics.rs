@@ -219,9 +219,7 @@ fn microfacet_roughness_follows_pbrt_v4() {
     // Only the anisotropic one is reported (its tangent is arbitrary).
     assert_eq!(s.warnings.len(), 1, "{:#?}", s.warnings);
     assert!(s.warnings[0].message.contains("anisotropic"));
-    assert!(
-        err("WorldBegin\nMaterial \"conductor\" \"float roughness\" -0.1\n").contains(">= 0")
-    );
+    assert!(err("WorldBegin\nMaterial \"conductor\" \"float roughness\" -0.1\n").contains(">= 0"));
 }
 
 #[test]

@@ -113,12 +113,7 @@ impl TrowbridgeReitz {
         let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2_disk;
         let nz = (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
         let nh = p1 * t1 + p2 * t2 + nz * vh;
-        Vec3::new(
-            self.alpha_x * nh.x,
-            self.alpha_y * nh.y,
-            nh.z.max(1e-6),
-        )
-        .normalize()
+        Vec3::new(self.alpha_x * nh.x, self.alpha_y * nh.y, nh.z.max(1e-6)).normalize()
     }
 }
 
@@ -149,11 +144,7 @@ mod tests {
             for j in 0..np {
                 let phi = (j as f64 + 0.5) * dp;
                 let (st, ct) = theta.sin_cos();
-                let w = Vec3::new(
-                    (st * phi.cos()) as f32,
-                    (st * phi.sin()) as f32,
-                    ct as f32,
-                );
+                let w = Vec3::new((st * phi.cos()) as f32, (st * phi.sin()) as f32, ct as f32);
                 sum += f(w) * theta.sin();
             }
         }
@@ -174,7 +165,11 @@ mod tests {
         // ∫ G1(w) max(0, w·m) D(m) dm = cos θ_w (Heitz 2014, eq. 1).
         for (ax, ay) in [(0.2, 0.2), (0.6, 0.6), (0.05, 0.4)] {
             let d = TrowbridgeReitz::new(ax, ay);
-            for w in [spherical(0.9, 0.3), spherical(0.3, 2.0), spherical(0.05, 4.0)] {
+            for w in [
+                spherical(0.9, 0.3),
+                spherical(0.3, 2.0),
+                spherical(0.05, 4.0),
+            ] {
                 let i = hemisphere_integral(|m| d.d_visible(w, m) as f64);
                 assert!((i - 1.0).abs() < 5e-3, "alpha {ax}/{ay}, w {w}: {i}");
             }
@@ -196,7 +191,11 @@ mod tests {
     fn sampled_normals_face_the_viewer() {
         let mut rng = Pcg32::new(3, 5);
         let d = TrowbridgeReitz::new(0.05, 0.4);
-        for w in [spherical(0.01, 1.0), spherical(0.7, 3.0), -spherical(0.2, 5.0)] {
+        for w in [
+            spherical(0.01, 1.0),
+            spherical(0.7, 3.0),
+            -spherical(0.2, 5.0),
+        ] {
             for _ in 0..10_000 {
                 let m = d.sample_visible(w, Vec2::new(rng.uniform(), rng.uniform()));
                 assert!((m.length() - 1.0).abs() < 1e-4 && m.z > 0.0);

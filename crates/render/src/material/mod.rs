@@ -100,7 +100,9 @@ impl Material {
                 }
                 let fresnel = match conductor {
                     ConductorDesc::Reflectance(r) => ConductorFresnel::from_reflectance(*r),
-                    ConductorDesc::EtaK { eta, k } => ConductorFresnel::Complex { eta: *eta, k: *k },
+                    ConductorDesc::EtaK { eta, k } => {
+                        ConductorFresnel::Complex { eta: *eta, k: *k }
+                    }
                 };
                 Material::RoughConductor {
                     fresnel,
