@@ -95,7 +95,7 @@ pub fn conductor_sample(
     }
     let wo_m = wo_u.dot(m);
     let pdf = d.d_visible(wo_u, m) / (4.0 * wo_m);
-    if !(pdf > 0.0) {
+    if pdf.is_nan() || pdf <= 0.0 {
         return None;
     }
     let f = fr.eval(wo_m) * (d.d(m) * d.g(wo_u, wi_u) / (4.0 * wo_u.z * wi_u.z));
