@@ -123,6 +123,16 @@ impl Material {
         )
     }
 
+    /// True where the photon integrators (photon map, SPPM) treat the surface like a
+    /// specular one: camera paths continue through it by sampling its BSDF and photons
+    /// are not stored on it. That is every delta BSDF and the rough dielectric, whose
+    /// transmitted light a density estimate on the reflecting side could not gather;
+    /// rough conductors are glossy surfaces that keep photons and visible points, the
+    /// BSDF evaluated in the estimate (as in pbrt-v4's SPPM).
+    pub fn passes_photon_paths(&self) -> bool {
+        self.is_specular() || matches!(self, Material::RoughDielectric { .. })
+    }
+
     /// True for the Lambertian material only: what radiosity can mesh and solve.
     pub fn is_diffuse(&self) -> bool {
         matches!(self, Material::Diffuse { .. })

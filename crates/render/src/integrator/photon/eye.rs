@@ -84,7 +84,7 @@ pub fn radiance(
         let wo_world = -ray.d.normalize();
         let emitted = surface_emission(world, &hit, wo_world);
         let material = world.materials[hit.material as usize];
-        if material.is_specular() {
+        if material.passes_photon_paths() {
             // The camera sees emitters directly or through specular chains only.
             l += beta * emitted;
             if depth == settings.max_depth {
@@ -206,7 +206,7 @@ fn final_gather(
             let wo_y_world = -ray.d.normalize();
             let frame_y = Frame::from_normal(y.ns);
             let wo_y = frame_y.to_local(wo_y_world);
-            if mat_y.is_specular() {
+            if mat_y.passes_photon_paths() {
                 let Some(wi) = specular_bounce(&mat_y, &frame_y, wo_y, &mut s, &mut beta) else {
                     break;
                 };
