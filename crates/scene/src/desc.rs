@@ -140,6 +140,21 @@ pub enum MaterialDesc {
     /// Smooth conductor: a perfect mirror with the given reflectance, or Fresnel
     /// reflection from complex index `eta + i k` per channel.
     Conductor(ConductorDesc),
+    /// Rough dielectric (Trowbridge–Reitz microfacets): relative index `eta` and the
+    /// distribution's alpha along the surface's two tangent axes (already remapped
+    /// from pbrt's `roughness` when `remaproughness` is true).
+    RoughDielectric {
+        eta: f32,
+        alpha_u: f32,
+        alpha_v: f32,
+    },
+    /// Rough conductor (Trowbridge–Reitz microfacets) with the Fresnel term of
+    /// `conductor` and alphas as for [`MaterialDesc::RoughDielectric`].
+    RoughConductor {
+        conductor: ConductorDesc,
+        alpha_u: f32,
+        alpha_v: f32,
+    },
     /// `"interface"`: no surface at all (a boundary between media); rays pass through.
     Interface,
 }

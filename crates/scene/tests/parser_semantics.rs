@@ -150,7 +150,12 @@ fn materials_map_to_radiant_materials() {
             reflectance: Rgb::new(0.2, 0.4, 0.6),
         },
         MaterialDesc::Dielectric { eta: 1.5168 },
-        MaterialDesc::Dielectric { eta: 1.33 },
+        // remaproughness (default true): alpha = sqrt(roughness).
+        MaterialDesc::RoughDielectric {
+            eta: 1.33,
+            alpha_u: 0.1f32.sqrt(),
+            alpha_v: 0.1f32.sqrt(),
+        },
         // pbrt-v4's default conductor is copper.
         MaterialDesc::Conductor(ConductorDesc::EtaK {
             eta: named("metal-Cu-eta"),
@@ -170,13 +175,51 @@ fn materials_map_to_radiant_materials() {
         MaterialDesc::Interface,
     ];
     assert_eq!(s.materials, expected);
-    // One warning each: BK7 without dispersion, roughness, coateddiffuse, texture.
+    // One warning each: BK7 without dispersion, coateddiffuse, texture.
     let msgs: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
-    assert_eq!(msgs.len(), 4, "{msgs:#?}");
-    assert!(
-        msgs[1].contains("rendered as smooth") && msgs[2].contains("diffuse with reflectance 0.5")
-    );
+    assert_eq!(msgs.len(), 3, "{msgs:#?}");
+    assert!(msgs[1].contains("diffuse with reflectance 0.5"));
     assert!(err("WorldBegin\nMaterial \"plastic\"\n").contains("unknown material type"));
+}
+
+#[test]
+fn microfacet_roughness_follows_pbrt_v4() {
+    let s = parse(
+        "WorldBegin\n\
+         Material \"conductor\" \"float roughness\" 0.25 \"float vroughness\" 0.04\n\
+         Material \"conductor\" \"rgb reflectance\" [ 0.5 0.5 0.5 ] \"float uroughness\" 0.3 \"float vroughness\" 0.3 \"bool remaproughness\" false\n\
+         Material \"dielectric\" \"float roughness\" 0\n\
+         Material \"dielectric\" \"float roughness\" 0.2 \"bool remaproughness\" false\n",
+    );
+    let cu = ConductorDesc::EtaK {
+        eta: metal_spectrum("metal-Cu-eta").unwrap(),
+        k: metal_spectrum("metal-Cu-k").unwrap(),
+    };
+    assert_eq!(
+        s.materials,
+        vec![
+            MaterialDesc::RoughConductor {
+                conductor: cu,
+                alpha_u: 0.5,
+                alpha_v: 0.2,
+            },
+            MaterialDesc::RoughConductor {
+                conductor: ConductorDesc::Reflectance(Rgb::splat(0.5)),
+                alpha_u: 0.3,
+                alpha_v: 0.3,
+            },
+            MaterialDesc::Dielectric { eta: 1.5 },
+            MaterialDesc::RoughDielectric {
+                eta: 1.5,
+                alpha_u: 0.2,
+                alpha_v: 0.2,
+            },
+        ]
+    );
+    // Only the anisotropic one is reported (its tangent is arbitrary).
+    assert_eq!(s.warnings.len(), 1, "{:#?}", s.warnings);
+    assert!(s.warnings[0].message.contains("anisotropic"));
+    assert!(err("WorldBegin\nMaterial \"conductor\" \"float roughness\" -0.1\n").contains(">= 0"));
 }
 
 #[test]

@@ -81,7 +81,10 @@ impl RadiosityScene {
                     reflectance.to_array().map(|c| (c as f64).clamp(0.0, 1.0))
                 }
                 MaterialDesc::Interface => [0.0; 3],
-                MaterialDesc::Dielectric { .. } | MaterialDesc::Conductor(_) => {
+                MaterialDesc::Dielectric { .. }
+                | MaterialDesc::Conductor(_)
+                | MaterialDesc::RoughDielectric { .. }
+                | MaterialDesc::RoughConductor { .. } => {
                     specular_at.get_or_insert_with(|| shape.loc.clone());
                     [0.0; 3]
                 }
@@ -106,7 +109,7 @@ impl RadiosityScene {
         if let Some(loc) = specular_at {
             warnings.push(Warning {
                 loc,
-                message: "radiosity: specular materials (mirror, glass, metal) have no diffuse part; their patches absorb all light".into(),
+                message: "radiosity: specular and glossy materials (mirror, glass, metal, rough metal and glass) have no diffuse part; their patches absorb all light".into(),
             });
         }
         for light in &desc.lights {

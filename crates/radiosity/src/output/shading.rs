@@ -142,7 +142,7 @@ impl<'a> Shading<'a> {
             // sphere's patches); diffuse ones show only their front.
             let struck_material =
                 self.world.materials[self.scene.tag(hit.struck).material as usize];
-            if struck_material.is_specular() {
+            if !struck_material.is_diffuse() {
                 let i = hit.patch.unwrap_or(hit.struck);
                 if hit.patch.is_some() {
                     l += beta * self.emission(i) * inv_pi;
@@ -235,7 +235,7 @@ impl<'a> Shading<'a> {
             };
             let Some(j) = hit.patch else { continue };
             let patch = &self.scene.patches.patches[j];
-            let diffuse = !self.world.materials[self.scene.tag(j).material as usize].is_specular();
+            let diffuse = self.world.materials[self.scene.tag(j).material as usize].is_diffuse();
             if refine_near && hit.t < near && diffuse {
                 let facing = patch.normal.as_vec3();
                 let (reflected, traced) = self.gather(

@@ -98,11 +98,11 @@ pub fn sample_direct(
         return out;
     };
     let wi = at.frame.to_local(ls.wi);
-    // Light must arrive on the side the path came from (the geometric test prevents
+    // Light must arrive on the side the BSDF sees it on: the side the path came from
+    // for reflection, the other one for transmission (the geometric test prevents
     // leaks through shading normals).
-    let same_side = ls.wi.dot(hit.ng) * at.wo_world.dot(hit.ng) > 0.0;
     let f = at.material.eval(at.wo, wi) * wi.z.abs();
-    if !same_side || f.is_black() {
+    if !sides_agree(hit, at.wo_world, ls.wi, at.wo, wi) || f.is_black() {
         return out;
     }
     out.shadow_rays = 1;
@@ -119,6 +119,22 @@ pub fn sample_direct(
         delta: ls.delta,
     });
     out
+}
+
+/// True when the pair (`wo`, `wi`) is a reflection by the geometric normal exactly
+/// when it is one in the shading frame (local `wo_local`, `wi_local`): a BSDF value
+/// computed in the shading frame then applies. Grazing directions (zero cosine with
+/// the geometric normal) count as transmission.
+pub fn sides_agree(
+    hit: &SurfaceHit,
+    wo_world: Vec3,
+    wi_world: Vec3,
+    wo_local: Vec3,
+    wi_local: Vec3,
+) -> bool {
+    let geometric = wi_world.dot(hit.ng) * wo_world.dot(hit.ng) > 0.0;
+    let shading = wi_local.z * wo_local.z > 0.0;
+    geometric == shading
 }
 
 /// Radiance emitted by the surface at `hit` towards `wo` (zero off emitters).

@@ -4,7 +4,7 @@
 
 use crate::geometry::Ray;
 use crate::light::{Light, LightSampleContext};
-use crate::material::{Material, TransportMode};
+use crate::material::TransportMode;
 use crate::sampler::PixelSample;
 use crate::world::{NO_LIGHT, World};
 use radiant_math::color::Rgb;
@@ -174,11 +174,11 @@ pub fn radiance(
             break;
         };
         let wi = frame.to_world(bs.wi);
-        if !bs.specular && wi.dot(hit.ng) * wo_world.dot(hit.ng) <= 0.0 {
+        if !bs.specular && !direct::sides_agree(&hit, wo_world, wi, wo, bs.wi) {
             break;
         }
         beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-        if let Material::Dielectric { eta } = material
+        if let Some(eta) = material.dielectric_eta()
             && wi.dot(hit.ng) * wo_world.dot(hit.ng) < 0.0
         {
             // Refraction: track eta^2 so roulette sees the unscaled throughput.

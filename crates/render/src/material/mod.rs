@@ -1,10 +1,16 @@
 //! Materials and their BSDFs, evaluated in the local shading frame (normal = +z).
 //!
 //! The set is closed — Lambertian diffuse, perfect mirror, smooth conductor, smooth
-//! dielectric — so it is one enum with `match`. All are two-sided: a diffuse surface
-//! reflects on both sides, a dielectric knows which side it is entered from.
+//! dielectric, rough (microfacet) conductor and dielectric — so it is one enum with
+//! `match`. All are two-sided: a diffuse surface reflects on both sides, a dielectric
+//! knows which side it is entered from.
 
 pub mod fresnel;
+pub mod microfacet;
+pub mod rough;
+
+pub use microfacet::TrowbridgeReitz;
+pub use rough::ConductorFresnel;
 
 use glam::{Vec2, Vec3};
 
@@ -30,6 +36,16 @@ pub enum Material {
     Conductor { eta: Rgb, k: Rgb },
     /// Smooth dielectric, index `eta` inside relative to outside (normal side).
     Dielectric { eta: f32 },
+    /// Microfacet conductor (Trowbridge–Reitz), never effectively smooth.
+    RoughConductor {
+        fresnel: ConductorFresnel,
+        distribution: TrowbridgeReitz,
+    },
+    /// Microfacet dielectric (Trowbridge–Reitz), `eta` as for `Dielectric`.
+    RoughDielectric {
+        eta: f32,
+        distribution: TrowbridgeReitz,
+    },
     /// No surface: paths continue straight through.
     Interface,
 }
@@ -58,13 +74,77 @@ impl Material {
             MaterialDesc::Conductor(ConductorDesc::EtaK { eta, k }) => {
                 Material::Conductor { eta: *eta, k: *k }
             }
+            MaterialDesc::RoughDielectric {
+                eta,
+                alpha_u,
+                alpha_v,
+            } => {
+                let distribution = TrowbridgeReitz::new(*alpha_u, *alpha_v);
+                if distribution.effectively_smooth() {
+                    Material::Dielectric { eta: *eta }
+                } else {
+                    Material::RoughDielectric {
+                        eta: *eta,
+                        distribution,
+                    }
+                }
+            }
+            MaterialDesc::RoughConductor {
+                conductor,
+                alpha_u,
+                alpha_v,
+            } => {
+                let distribution = TrowbridgeReitz::new(*alpha_u, *alpha_v);
+                if distribution.effectively_smooth() {
+                    return Material::from_desc(&MaterialDesc::Conductor(conductor.clone()));
+                }
+                let fresnel = match conductor {
+                    ConductorDesc::Reflectance(r) => ConductorFresnel::from_reflectance(*r),
+                    ConductorDesc::EtaK { eta, k } => {
+                        ConductorFresnel::Complex { eta: *eta, k: *k }
+                    }
+                };
+                Material::RoughConductor {
+                    fresnel,
+                    distribution,
+                }
+            }
             MaterialDesc::Interface => Material::Interface,
         }
     }
 
     /// True when the BSDF is a Dirac distribution (no evaluation, only sampling).
     pub fn is_specular(&self) -> bool {
-        !matches!(self, Material::Diffuse { .. })
+        !matches!(
+            self,
+            Material::Diffuse { .. }
+                | Material::RoughConductor { .. }
+                | Material::RoughDielectric { .. }
+        )
+    }
+
+    /// True where the photon integrators (photon map, SPPM) treat the surface like a
+    /// specular one: camera paths continue through it by sampling its BSDF and photons
+    /// are not stored on it. That is every delta BSDF and the rough dielectric, whose
+    /// transmitted light a density estimate on the reflecting side could not gather;
+    /// rough conductors are glossy surfaces that keep photons and visible points, the
+    /// BSDF evaluated in the estimate (as in pbrt-v4's SPPM).
+    pub fn passes_photon_paths(&self) -> bool {
+        self.is_specular() || matches!(self, Material::RoughDielectric { .. })
+    }
+
+    /// True for the Lambertian material only: what radiosity can mesh and solve.
+    pub fn is_diffuse(&self) -> bool {
+        matches!(self, Material::Diffuse { .. })
+    }
+
+    /// The relative index of a (smooth or rough) dielectric, for tracking the η²
+    /// scaling of refracted radiance.
+    pub fn dielectric_eta(&self) -> Option<f32> {
+        match *self {
+            Material::Dielectric { eta } | Material::RoughDielectric { eta, .. } => Some(eta),
+            _ => None,
+        }
     }
 
     /// The diffuse reflectance (zero for purely specular materials); radiosity uses
@@ -77,10 +157,23 @@ impl Material {
     }
 
     /// BSDF value for local directions `wo` (towards the viewer) and `wi` (towards the
-    /// light). Specular lobes evaluate to zero.
+    /// light), in radiance transport. Specular lobes evaluate to zero.
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        self.eval_mode(wo, wi, TransportMode::Radiance)
+    }
+
+    /// [`eval`](Self::eval) for either transport mode (they differ only in the η²
+    /// factor of rough transmission).
+    pub fn eval_mode(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
         match self {
             Material::Diffuse { albedo } if wo.z * wi.z > 0.0 => *albedo * INV_PI,
+            Material::RoughConductor {
+                fresnel,
+                distribution,
+            } => rough::conductor_eval(distribution, fresnel, wo, wi),
+            Material::RoughDielectric { eta, distribution } => {
+                Rgb::splat(rough::dielectric_eval(distribution, *eta, wo, wi, mode))
+            }
             _ => Rgb::BLACK,
         }
     }
@@ -90,6 +183,12 @@ impl Material {
         match self {
             Material::Diffuse { .. } if wo.z * wi.z > 0.0 => {
                 sampling::cosine_hemisphere_pdf(wi.z.abs())
+            }
+            Material::RoughConductor { distribution, .. } => {
+                rough::conductor_pdf(distribution, wo, wi)
+            }
+            Material::RoughDielectric { eta, distribution } => {
+                rough::dielectric_pdf(distribution, *eta, wo, wi)
             }
             _ => 0.0,
         }
@@ -122,6 +221,13 @@ impl Material {
                 1.0,
             )),
             Material::Dielectric { eta } => Some(sample_dielectric(wo, eta, u1, mode)),
+            Material::RoughConductor {
+                fresnel,
+                distribution,
+            } => rough::conductor_sample(&distribution, &fresnel, wo, u2),
+            Material::RoughDielectric { eta, distribution } => {
+                rough::dielectric_sample(&distribution, eta, wo, u1, u2, mode)
+            }
             Material::Interface => Some(BsdfSample {
                 wi: -wo,
                 f: Rgb::splat(1.0 / wo.z.abs()),

@@ -104,11 +104,11 @@ impl World {
     }
 
     /// Bounding spheres (centre, radius) of the specular geometry (mirrors, conductors,
-    /// glass): one per mesh, quadric or instance that has any.
+    /// glass, rough glass): one per mesh, quadric or instance that has any.
     pub fn specular_bounds(&self) -> Vec<(Vec3, f32)> {
         let pick = |m: u32| {
             let m = &self.materials[m as usize];
-            m.is_specular() && *m != Material::Interface
+            m.passes_photon_paths() && *m != Material::Interface
         };
         self.geometry
             .bounding_spheres_where(&self.prototypes, &pick)

@@ -6,8 +6,14 @@
 //! - `"conductor"`: `reflectance` (an artist's mirror colour), else `eta` and `k`
 //!   (spectra; default copper, `metal-Cu-eta` / `metal-Cu-k`).
 //! - `"interface"` (also `""`, `"none"`): no surface.
-//! - Roughness (`roughness`, `uroughness`, `vroughness`) > 0 is read and rendered as
-//!   smooth, with a warning. Other material types render as diffuse 0.5 with a warning.
+//! - `dielectric` and `conductor` take pbrt-v4's microfacet roughness: `roughness`
+//!   (default 0) sets both `uroughness` and `vroughness` unless they are given, and
+//!   `remaproughness` (default true) maps each to the Trowbridge–Reitz alpha as
+//!   alpha = sqrt(roughness); with it false the values are alphas already. Any
+//!   non-zero alpha gives `RoughDielectric` / `RoughConductor` (the renderer keeps
+//!   alphas below its smooth threshold a delta BSDF). Textured roughness is reported
+//!   and read as 0.
+//! - Other material types render as diffuse 0.5 with a warning.
 
 use super::Parser;
 use super::spectrum_param::SpectrumUse;
@@ -159,14 +165,20 @@ impl Parser {
                 )?,
             },
             "dielectric" => {
-                self.warn_if_rough(ps, loc, owner)?;
-                MaterialDesc::Dielectric {
-                    eta: self.dielectric_eta(ps, owner)?,
+                let alpha = self.microfacet_alpha(ps, loc, owner)?;
+                let eta = self.dielectric_eta(ps, owner)?;
+                match alpha {
+                    None => MaterialDesc::Dielectric { eta },
+                    Some((alpha_u, alpha_v)) => MaterialDesc::RoughDielectric {
+                        eta,
+                        alpha_u,
+                        alpha_v,
+                    },
                 }
             }
             "conductor" => {
-                self.warn_if_rough(ps, loc, owner)?;
-                if ps.has("reflectance") {
+                let alpha = self.microfacet_alpha(ps, loc, owner)?;
+                let conductor = if ps.has("reflectance") {
                     let r = self.spectrum_or(
                         ps,
                         "reflectance",
@@ -184,6 +196,17 @@ impl Parser {
                         eta: self.spectrum_or(ps, "eta", SpectrumUse::Unbounded, cu_eta, owner)?,
                         k: self.spectrum_or(ps, "k", SpectrumUse::Unbounded, cu_k, owner)?,
                     })
+                };
+                match (alpha, conductor) {
+                    (None, c) => c,
+                    (Some((alpha_u, alpha_v)), MaterialDesc::Conductor(conductor)) => {
+                        MaterialDesc::RoughConductor {
+                            conductor,
+                            alpha_u,
+                            alpha_v,
+                        }
+                    }
+                    (Some(_), _) => unreachable!("conductors build a Conductor desc"),
                 }
             }
             "interface" | "" | "none" => MaterialDesc::Interface,
@@ -203,40 +226,66 @@ impl Parser {
         })
     }
 
-    /// pbrt-v4: `roughness` sets both `uroughness` and `vroughness` unless they are
-    /// given. radiant renders only smooth dielectrics and conductors.
-    fn warn_if_rough(
+    /// The microfacet alphas (u, v) of a dielectric or conductor, or `None` when both
+    /// are zero (a smooth surface). pbrt-v4: `roughness` stands for `uroughness` and
+    /// `vroughness` where they are absent; `remaproughness` (default true) turns each
+    /// roughness into alpha = sqrt(roughness).
+    fn microfacet_alpha(
         &mut self,
         ps: &ParamSet,
         loc: &FileLoc,
         owner: &str,
-    ) -> Result<(), SceneError> {
-        ps.lookup("remaproughness");
-        let mut rough = false;
-        for name in ["roughness", "uroughness", "vroughness"] {
-            if let Some(p) = ps.lookup(name) {
-                rough |= match &p.value {
-                    ParamValue::Float(v) => v.iter().any(|&r| r != 0.0),
-                    ParamValue::Texture(_) => true,
-                    other => {
-                        return Err(SceneError::at(
+    ) -> Result<Option<(f32, f32)>, SceneError> {
+        let remap = ps.bool("remaproughness", true)?;
+        let mut read = |name: &str| -> Result<Option<f32>, SceneError> {
+            let Some(p) = ps.lookup(name) else {
+                return Ok(None);
+            };
+            match &p.value {
+                ParamValue::Float(v) if v.len() == 1 => {
+                    if v[0].is_finite() && v[0] >= 0.0 {
+                        Ok(Some(v[0]))
+                    } else {
+                        Err(SceneError::at(
                             &p.loc,
-                            format!(
-                                "parameter \"{name}\" has type \"{}\", expected \"float\"",
-                                other.type_name()
-                            ),
-                        ));
+                            format!("\"{name}\" {} must be finite and >= 0", v[0]),
+                        ))
                     }
-                };
+                }
+                ParamValue::Texture(_) => {
+                    let at = p.loc.clone();
+                    self.warn(
+                        &at,
+                        format!("{owner}: textured \"{name}\" is not supported; read as 0"),
+                    );
+                    Ok(Some(0.0))
+                }
+                other => Err(SceneError::at(
+                    &p.loc,
+                    format!(
+                        "parameter \"{name}\" has type \"{}\" or the wrong count; expected one float",
+                        other.type_name()
+                    ),
+                )),
             }
+        };
+        let both = read("roughness")?.unwrap_or(0.0);
+        let u = read("uroughness")?.unwrap_or(both);
+        let v = read("vroughness")?.unwrap_or(both);
+        let to_alpha = |r: f32| if remap { r.sqrt() } else { r };
+        let (alpha_u, alpha_v) = (to_alpha(u), to_alpha(v));
+        if alpha_u == 0.0 && alpha_v == 0.0 {
+            return Ok(None);
         }
-        if rough {
+        if alpha_u != alpha_v {
             self.warn(
                 loc,
-                format!("{owner}: rough surfaces are not supported; rendered as smooth"),
+                format!(
+                    "{owner}: anisotropic roughness is oriented along an arbitrary tangent of the shading normal, not the surface's u direction"
+                ),
             );
         }
-        Ok(())
+        Ok(Some((alpha_u, alpha_v)))
     }
 
     fn dielectric_eta(&mut self, ps: &ParamSet, owner: &str) -> Result<f32, SceneError> {

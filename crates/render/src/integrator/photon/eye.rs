@@ -10,7 +10,9 @@ use super::record::FIRST_DIFFUSE;
 use super::settings::Visualize;
 use super::{PhotonMaps, facing};
 use crate::geometry::Ray;
-use crate::integrator::direct::{ShadingPoint, environment, sample_direct, surface_emission};
+use crate::integrator::direct::{
+    ShadingPoint, environment, sample_direct, sides_agree, surface_emission,
+};
 use crate::integrator::specular::specular_bounce;
 use crate::light::SceneSphere;
 use crate::material::TransportMode;
@@ -82,7 +84,7 @@ pub fn radiance(
         let wo_world = -ray.d.normalize();
         let emitted = surface_emission(world, &hit, wo_world);
         let material = world.materials[hit.material as usize];
-        if material.is_specular() {
+        if material.passes_photon_paths() {
             // The camera sees emitters directly or through specular chains only.
             l += beta * emitted;
             if depth == settings.max_depth {
@@ -190,7 +192,7 @@ fn final_gather(
             continue;
         };
         let wi = frame.to_world(bs.wi);
-        if !bs.specular && wi.dot(x.ng) * wo_world.dot(x.ng) <= 0.0 {
+        if !bs.specular && !sides_agree(x, wo_world, wi, wo, bs.wi) {
             continue;
         }
         let mut beta = bs.f * (bs.wi.z.abs() / bs.pdf);
@@ -204,7 +206,7 @@ fn final_gather(
             let wo_y_world = -ray.d.normalize();
             let frame_y = Frame::from_normal(y.ns);
             let wo_y = frame_y.to_local(wo_y_world);
-            if mat_y.is_specular() {
+            if mat_y.passes_photon_paths() {
                 let Some(wi) = specular_bounce(&mat_y, &frame_y, wo_y, &mut s, &mut beta) else {
                     break;
                 };

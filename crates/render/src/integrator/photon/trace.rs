@@ -126,7 +126,7 @@ pub fn trace_photon(
         // Importance transport: the BSDF's "outgoing" direction points back along the
         // photon's path, towards the light.
         let wo_world = -ray.d.normalize();
-        if !material.is_specular() {
+        if !material.passes_photon_paths() {
             let landing = Landing {
                 hit: &hit,
                 wi: wo_world,
@@ -149,7 +149,7 @@ pub fn trace_photon(
         };
         let wi_world = frame.to_world(bs.wi);
         let (wo_ng, wi_ng) = (wo_world.dot(hit.ng), wi_world.dot(hit.ng));
-        if !bs.specular && wo_ng * wi_ng <= 0.0 {
+        if !bs.specular && (wo_ng * wi_ng > 0.0) != (wo.z * bs.wi.z > 0.0) {
             break;
         }
         let mut weight = bs.f * (bs.wi.z.abs() / bs.pdf);
@@ -163,9 +163,12 @@ pub fn trace_photon(
             break;
         }
         power *= weight * (1.0 / q);
-        specular_chain &= bs.specular;
+        // Rough glass counts as specular here: photons through it are caustics, which
+        // camera paths (passing through it too) find only in the caustic map.
+        let specular = bs.specular || material.passes_photon_paths();
+        specular_chain &= specular;
         if bounces == 0 {
-            first_specular = bs.specular;
+            first_specular = specular;
         }
         ray = hit.spawn_ray(wi_world);
     }

@@ -72,7 +72,7 @@ pub fn camera_sample(
         let material = world.materials[hit.material as usize];
         let frame = Frame::from_normal(hit.ns);
         let wo = frame.to_local(wo_world);
-        if material.is_specular() {
+        if material.passes_photon_paths() {
             if depth == max_depth {
                 break;
             }
