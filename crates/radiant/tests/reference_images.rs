@@ -30,6 +30,7 @@ use radiant::image::metrics::{RELMSE_EPSILON, compare};
 use radiant::image::tiles::{TileCriterion, TileStats, compare_tiles};
 use radiant::image::{Image, read_image};
 use radiant::render::Overrides;
+use radiant::scene::builtin::builtin_scene;
 
 const TILE: usize = 16;
 const PASSES: u64 = 4;
