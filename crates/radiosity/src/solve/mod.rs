@@ -423,6 +423,9 @@ pub fn solve_from<V: Visibility>(
     Ok(solution)
 }
 
+/// Patch-to-patch factor evaluations per thread in a block of factor-matrix rows.
+const FACTOR_BLOCK_WORK: usize = 1 << 18;
+
 /// The full factor matrix in blocks of rows (parallel within a block), reporting after
 /// each block. `None` when the hook asked to stop.
 fn factor_matrix<V: Visibility>(
@@ -433,7 +436,12 @@ fn factor_matrix<V: Visibility>(
 ) -> Result<Option<FormFactorMatrix<f64>>, RadiosityError> {
     let n = set.len();
     let mut values = vec![0.0; n * n];
-    let block = (n / 64).clamp(16, 1024);
+    // A row costs about n patch projections (hemi-cube) or ray casts, so a block of
+    // FACTOR_BLOCK_WORK / n rows is a similar amount of work at any n (tens of
+    // milliseconds per thread); the hook, which checks for cancellation, runs between
+    // blocks. At least a row per thread keeps every thread busy.
+    let threads = rayon::current_num_threads();
+    let block = (FACTOR_BLOCK_WORK * threads / n.max(1)).clamp(threads, 1024);
     let caster = RayCaster::new(matrix_ray_cast_settings());
     let hemicube = match settings.form_factor {
         FormFactorMethod::HemiCube => Some(HemiCube::new(settings.hemicube_resolution)?),

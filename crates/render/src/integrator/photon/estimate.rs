@@ -28,6 +28,14 @@ pub struct PhotonMap {
 impl PhotonMap {
     /// Compresses the photons and builds the tree.
     pub fn build(raw: Vec<RawPhoton>) -> PhotonMap {
+        PhotonMap::build_until(raw, &|| false).expect("never stopped")
+    }
+
+    /// [`PhotonMap::build`], giving up (`None`) once `stop` holds.
+    pub fn build_until(raw: Vec<RawPhoton>, stop: &(dyn Fn() -> bool + Sync)) -> Option<PhotonMap> {
+        if stop() {
+            return None;
+        }
         let scale = raw
             .par_iter()
             .map(|r| r.power.max_component())
@@ -39,10 +47,10 @@ impl PhotonMap {
         };
         let inv = 1.0 / scale;
         let photons: Vec<Photon> = raw.par_iter().map(|r| Photon::encode(r, inv)).collect();
-        PhotonMap {
-            tree: KdTree::build(photons),
+        Some(PhotonMap {
+            tree: KdTree::build_until(photons, stop)?,
             power_scale: scale,
-        }
+        })
     }
 
     /// Number of stored photons.

@@ -52,10 +52,36 @@ impl IrradianceCache {
         max_r2: f32,
         kernel: Kernel,
     ) -> IrradianceCache {
+        IrradianceCache::build_until(
+            global,
+            caustic,
+            global_k,
+            caustic_k,
+            max_r2,
+            kernel,
+            &|| false,
+        )
+        .expect("never stopped")
+    }
+
+    /// [`IrradianceCache::build`], giving up (`None`) once `stop` holds; asked once per
+    /// chunk of photons (a few thousand estimates, about a millisecond of work).
+    pub fn build_until(
+        global: &PhotonMap,
+        caustic: &PhotonMap,
+        global_k: u32,
+        caustic_k: u32,
+        max_r2: f32,
+        kernel: Kernel,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Option<IrradianceCache> {
         let photons = global.photons();
         let points: Vec<IrradiancePoint> = photons
             .par_chunks(256 * STRIDE)
             .flat_map_iter(|chunk| {
+                if stop() {
+                    return Vec::new();
+                }
                 let mut g = Neighbors::new(global_k as usize);
                 let mut c = Neighbors::new(caustic_k as usize);
                 chunk
@@ -81,9 +107,12 @@ impl IrradianceCache {
                     .collect::<Vec<_>>()
             })
             .collect();
-        IrradianceCache {
-            tree: KdTree::build(points),
+        if stop() {
+            return None;
         }
+        Some(IrradianceCache {
+            tree: KdTree::build_until(points, stop)?,
+        })
     }
 
     /// Number of precomputed points.

@@ -26,6 +26,8 @@ pub trait KdPoint {
 
 /// Ranges smaller than this are built on the current thread.
 const PARALLEL_BUILD: usize = 16 * 1024;
+/// Nodes at least this large ask whether to stop before partitioning.
+const POLL_BUILD: usize = 4 * 1024;
 
 /// Ranges this small are leaves: scanned in order, not split (contiguous in memory,
 /// cheaper than descending to single items).
@@ -171,19 +173,31 @@ fn sift_down(h: &mut [(f32, u32)], mut i: usize) {
 
 impl<T: KdPoint + Send> KdTree<T> {
     /// Builds the tree (reorders the items).
-    pub fn build(mut items: Vec<T>) -> KdTree<T> {
+    pub fn build(items: Vec<T>) -> KdTree<T> {
+        KdTree::build_until(items, &|| false).expect("never stopped")
+    }
+
+    /// [`KdTree::build`], giving up (`None`) once `stop` holds. `stop` is asked at every
+    /// node of at least [`POLL_BUILD`] items, so a stop takes effect within one
+    /// partition of that many items per thread (well under a millisecond).
+    pub fn build_until(mut items: Vec<T>, stop: &(dyn Fn() -> bool + Sync)) -> Option<KdTree<T>> {
         let mut axes = vec![0u8; items.len()];
         let bounds = items
             .iter()
             .fold(Aabb::EMPTY, |b, it| b.grow(it.position()));
-        build_range(&mut items, &mut axes, bounds);
-        KdTree { items, axes }
+        build_range(&mut items, &mut axes, bounds, stop);
+        (!stop()).then_some(KdTree { items, axes })
     }
 }
 
-fn build_range<T: KdPoint + Send>(items: &mut [T], axes: &mut [u8], bounds: Aabb) {
+fn build_range<T: KdPoint + Send>(
+    items: &mut [T],
+    axes: &mut [u8],
+    bounds: Aabb,
+    stop: &(dyn Fn() -> bool + Sync),
+) {
     let n = items.len();
-    if n <= LEAF as usize {
+    if n <= LEAF as usize || (n >= POLL_BUILD && stop()) {
         return;
     }
     let d = bounds.diagonal();
@@ -211,12 +225,12 @@ fn build_range<T: KdPoint + Send>(items: &mut [T], axes: &mut [u8], bounds: Aabb
     let right_axes = &mut rest_axes[1..];
     if n >= PARALLEL_BUILD {
         rayon::join(
-            || build_range(left, left_axes, left_b),
-            || build_range(right, right_axes, right_b),
+            || build_range(left, left_axes, left_b, stop),
+            || build_range(right, right_axes, right_b, stop),
         );
     } else {
-        build_range(left, left_axes, left_b);
-        build_range(right, right_axes, right_b);
+        build_range(left, left_axes, left_b, stop);
+        build_range(right, right_axes, right_b, stop);
     }
 }
 

@@ -192,39 +192,33 @@ impl PhotonMaps {
         stats.projection_fraction = projection.as_ref().map(|p| p.covered_power_fraction);
         stats.rays = global_rays + caustic_rays;
 
-        // Once stopped, nothing will be rendered from the maps: building their trees and
-        // the irradiance cache over what was traced (tens of seconds at 10^8 photons)
-        // would only delay the exit.
-        let stopped = progress.cancelled();
-        let (global_raw, caustic_raw) = if stopped {
-            (Vec::new(), Vec::new())
-        } else {
-            (global_raw, caustic_raw)
-        };
+        // Once stopped, nothing will be rendered from the maps: the trees and the
+        // irradiance cache (tens of seconds at 10^8 photons) ask the flag as they go and
+        // give up, leaving the maps empty.
+        let stop = || progress.cancelled();
         let t1 = Instant::now();
-        let global = PhotonMap::build(global_raw);
-        let caustic = if progress.cancelled() {
-            PhotonMap::build(Vec::new())
-        } else {
-            PhotonMap::build(caustic_raw)
-        };
+        let built = PhotonMap::build_until(global_raw, &stop)
+            .and_then(|g| Some((g, PhotonMap::build_until(caustic_raw, &stop)?)));
+        let (global, caustic) = built.unwrap_or_default();
         stats.build_seconds = t1.elapsed().as_secs_f64();
         stats.global_stored = global.len() as u64;
         stats.caustic_stored = caustic.len() as u64;
 
         let max_r2 = max_radius * max_radius;
         let t2 = Instant::now();
-        let irradiance = (!visualize && settings.final_gather_samples > 0 && !progress.cancelled())
-            .then(|| {
-                IrradianceCache::build(
-                    &global,
-                    &caustic,
-                    settings.global_lookup,
-                    settings.lookup,
-                    max_r2,
-                    settings.kernel,
-                )
-            });
+        let irradiance = if !visualize && settings.final_gather_samples > 0 && !stop() {
+            IrradianceCache::build_until(
+                &global,
+                &caustic,
+                settings.global_lookup,
+                settings.lookup,
+                max_r2,
+                settings.kernel,
+                &stop,
+            )
+        } else {
+            None
+        };
         stats.precompute_seconds = t2.elapsed().as_secs_f64();
         stats.irradiance_points = irradiance.as_ref().map_or(0, |c| c.len() as u64);
         PhotonMaps {
