@@ -594,3 +594,42 @@ fn oversized_requests_fail_with_a_located_estimate() {
         );
     }
 }
+
+/// A dense solve over about 10^4 patches spends minutes on its form factors; they are
+/// computed in blocks of rows that each ask for cancellation, so a signal ends the run
+/// within a second (process exit included) and the previous image stays.
+#[test]
+fn a_signal_during_the_form_factors_stops_the_run_at_once() {
+    let dir = temp_dir("factors-signal");
+    let image = dir.join("prev.exr");
+    let before = previous_render(&image);
+    let child = radiant()
+        .args([
+            "radiosity",
+            "--quiet",
+            "--solver",
+            "gaussseidel",
+            "--max-patch-area",
+            "240",
+            "--resolution",
+            "16x16",
+            "-o",
+        ])
+        .arg(&image)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let_it_run();
+    let sent = std::time::Instant::now();
+    signal(&child, "INT");
+    let out = child.wait_with_output().unwrap();
+    let latency = sent.elapsed();
+    let stderr = assert_clean_failure(&out, "radiosity form factors SIGINT");
+    assert!(stderr.contains("interrupted during the solve"), "{stderr}");
+    assert!(
+        latency < Duration::from_secs(1),
+        "{latency:?} from the signal to the exit"
+    );
+    assert_eq!(std::fs::read(&image).unwrap(), before);
+}
