@@ -627,8 +627,10 @@ fn a_signal_during_the_form_factors_stops_the_run_at_once() {
     let latency = sent.elapsed();
     let stderr = assert_clean_failure(&out, "radiosity form factors SIGINT");
     assert!(stderr.contains("interrupted during the solve"), "{stderr}");
+    // Uninterrupted, the factors take over 8 s here: a bound of 5 s tells a phase that
+    // polls from one that runs to its end, with room for a loaded machine.
     assert!(
-        latency < Duration::from_secs(1),
+        latency < Duration::from_secs(5),
         "{latency:?} from the signal to the exit"
     );
     assert_eq!(std::fs::read(&image).unwrap(), before);
