@@ -160,6 +160,21 @@ impl ChiSquareReport {
         self.failures(alpha, test_count).is_empty()
     }
 
+    /// One line for the test log: statistic, degrees of freedom, p-value, the pdf's
+    /// integral over the domain and the count of failed samples.
+    pub fn one_line(&self) -> String {
+        format!(
+            "{}: statistic {:.1}, dof {}, p-value {:.3e}, integral {:.6}, no sample {}",
+            self.name, self.statistic, self.dof, self.p_value, self.pdf_integral, self.no_sample
+        )
+    }
+
+    /// Prints [`one_line`](Self::one_line), then [`assert_passes`](Self::assert_passes).
+    pub fn check(&self, alpha: f64, test_count: u32) {
+        println!("{}", self.one_line());
+        self.assert_passes(alpha, test_count);
+    }
+
     /// Panics unless the routine passes at family-wise significance `alpha` over
     /// `test_count` tests. Before panicking it writes the observed, expected and
     /// residual histograms and a summary into [`failure_dir`](Self::failure_dir);
