@@ -11,7 +11,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 use radiant::image::{ImageMeta, write_image};
 use radiant::radiosity::RadiosityIntegrator;
-use radiant::radiosity::integrator::solve_session_observed;
+use radiant::radiosity::integrator::solve_session_resumed;
 use radiant::radiosity::output::export::{LitMesh, write_lit_mesh, write_patch_csv, write_ply};
 use radiant::radiosity::output::shading::Shading;
 use radiant::radiosity::settings::RadiositySettings;
@@ -20,8 +20,11 @@ use radiant::render::integrator::render_passes;
 use radiant::render::{Overrides, Progress, RenderContext, RenderControl};
 use radiant::scene::{FileLoc, Param, ParamValue};
 
-use crate::render_cmd::{capped_threads, check_output, draw_progress, load_scene, worker_pool};
+use crate::render_cmd::{
+    CheckpointArgs, capped_threads, check_output, draw_progress, load_scene, worker_pool,
+};
 use crate::signals::Interrupts;
+use radiant::checkpoint::{self, RunKey};
 
 fn parse_positive(s: &str) -> Result<usize, String> {
     match s.trim().parse::<usize>() {
@@ -142,6 +145,10 @@ pub struct RadiosityArgs {
     /// three quarters of the physical memory.
     #[arg(long, value_parser = crate::render_cmd::parse_bytes, value_name = "BYTES")]
     pub memory_limit: Option<u64>,
+    /// Progressive refinement's state (radiosity and unshot radiosity per patch, the
+    /// shot count, the power booked) goes to --checkpoint FILE; --resume continues it.
+    #[command(flatten)]
+    pub checkpoint: CheckpointArgs,
 }
 
 impl RadiosityArgs {
@@ -244,6 +251,7 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         bail!("--every K and --sequence NAME go together");
     }
     check_outputs(&args)?;
+    args.checkpoint.check()?;
     let threads = capped_threads(args.threads);
     if let Some(bytes) = args.memory_limit {
         radiant::render::budget::set_limit(bytes);
@@ -281,6 +289,43 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         eprintln!("{w}");
     }
     let (settings, scene) = (&radiosity.settings, &radiosity.scene);
+    let ckpt = &args.checkpoint;
+    let key = ckpt
+        .target()
+        .map(|_| RunKey::new(&desc, &desc.integrator, &ctx));
+    if key.is_some() {
+        // The state is progressive refinement's, on the mesh meshing makes: matrix
+        // solvers have none worth saving, and refinement passes change the mesh.
+        if settings.solver != radiant::radiosity::settings::SolverKind::Progressive {
+            bail!(
+                "--checkpoint/--resume: only the progressive solver can be checkpointed (the matrix solvers recompute their factors anyway)"
+            );
+        }
+        if settings.refine > 0 {
+            bail!(
+                "--checkpoint/--resume: not with --refine (each refinement pass solves a new mesh)"
+            );
+        }
+    }
+    let resume = match &key {
+        Some(key) => match ckpt.load(key)? {
+            Some(checkpoint::State::Radiosity(state)) => Some(state),
+            Some(other) => bail!(
+                "--resume: the checkpoint holds {} state, not a radiosity solve's",
+                other.kind()
+            ),
+            None => None,
+        },
+        None => None,
+    };
+    if let Some(state) = &resume
+        && !args.quiet
+    {
+        eprintln!("resuming after {} shots", state.shots);
+    }
+    let mut checkpoint_error = None;
+    let mut last_checkpoint = std::time::Instant::now();
+    let every = std::time::Duration::from_secs_f64(ckpt.checkpoint_every);
     let render_shading = |shading: &Shading, progress: &Progress| {
         render_passes(
             &ctx,
@@ -317,40 +362,70 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
             s.spawn(move || draw_progress(&progress, &bar_done));
         }
         let solved = pool.install(|| {
-            solve_session_observed(&ctx.world, scene, settings, &progress, |event| {
-                if let (
-                    SolveEvent::Shot {
-                        scene: mesh, state, ..
-                    },
-                    Some(every),
-                    Some(pattern),
-                ) = (event, args.every, &args.sequence)
-                    && every > 0
-                    && state.shots.is_multiple_of(every)
-                    && frame_error.is_none()
-                {
-                    let display = state.display_radiosity(&mesh.patches);
-                    let shading = Shading::new(mesh, &ctx.world, &display, &state.irradiance, 0)
-                        .with_specular_depth(settings.max_depth);
-                    let out = render_shading(&shading, &Progress::default());
-                    let path = frame_path(pattern, state.shots / every);
-                    let _writing = interrupts.writing();
-                    if let Err(e) = write_image(
-                        &path,
-                        &out.film.image(),
-                        &meta(out.spp_done, out.seconds),
-                        args.exposure,
-                    ) {
-                        frame_error = Some(anyhow::anyhow!("writing {}: {e}", path.display()));
+            solve_session_resumed(
+                &ctx.world,
+                scene,
+                settings,
+                &progress,
+                resume.as_ref(),
+                |event| {
+                    if let (SolveEvent::Shot { state, .. }, Some(path), Some(key)) =
+                        (event, ckpt.target(), &key)
+                    {
+                        // Read before deciding: the solve stops at this shot only if the
+                        // flag was set before it was shown, and then this saves it.
+                        let cancelled = progress.cancelled();
+                        let stop = ckpt.stop_after.is_some_and(|k| state.shots >= k as usize);
+                        if cancelled || stop || last_checkpoint.elapsed() >= every {
+                            let _writing = interrupts.writing();
+                            let saved = checkpoint::State::Radiosity((*state).clone());
+                            if let Err(e) = checkpoint::write(path, key, &saved) {
+                                checkpoint_error = Some(format!("writing {}: {e}", path.display()));
+                            }
+                            last_checkpoint = std::time::Instant::now();
+                        }
+                        if stop {
+                            progress.cancel.store(true, Ordering::SeqCst);
+                        }
                     }
-                }
-            })
+                    if let (
+                        SolveEvent::Shot {
+                            scene: mesh, state, ..
+                        },
+                        Some(every),
+                        Some(pattern),
+                    ) = (event, args.every, &args.sequence)
+                        && every > 0
+                        && state.shots.is_multiple_of(every)
+                        && frame_error.is_none()
+                    {
+                        let display = state.display_radiosity(&mesh.patches);
+                        let shading =
+                            Shading::new(mesh, &ctx.world, &display, &state.irradiance, 0)
+                                .with_specular_depth(settings.max_depth);
+                        let out = render_shading(&shading, &Progress::default());
+                        let path = frame_path(pattern, state.shots / every);
+                        let _writing = interrupts.writing();
+                        if let Err(e) = write_image(
+                            &path,
+                            &out.film.image(),
+                            &meta(out.spp_done, out.seconds),
+                            args.exposure,
+                        ) {
+                            frame_error = Some(anyhow::anyhow!("writing {}: {e}", path.display()));
+                        }
+                    }
+                },
+            )
         });
         bar_done.store(true, Ordering::SeqCst);
         solved
     })?;
     if let Some(e) = frame_error {
         return Err(e);
+    }
+    if let Some(e) = checkpoint_error {
+        eprintln!("warning: {e}");
     }
     let scene = solved.scene(scene);
     let solution = &solved.solution;
@@ -388,8 +463,12 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         } else {
             ""
         };
+        let saved = match ckpt.target() {
+            Some(path) => format!("; the solve's state is in {}", path.display()),
+            None => String::new(),
+        };
         bail!(
-            "interrupted during the solve after {} iterations: no mesh, table or image written{frames}",
+            "interrupted during the solve after {} iterations: no mesh, table or image written{frames}{saved}",
             solution.iterations
         );
     }

@@ -8,7 +8,9 @@ use std::time::Duration;
 
 use anyhow::{Context, bail};
 use clap::Args;
+use radiant::checkpoint::{self, RunKey};
 use radiant::image::{ImageMeta, write_image};
+use radiant::render::integrator::{CheckpointHook, IntegratorState};
 use radiant::render::{Overrides, Progress};
 
 use crate::signals::Interrupts;
@@ -54,6 +56,73 @@ pub struct RenderArgs {
     /// three quarters of the physical memory.
     #[arg(long, value_parser = parse_bytes, value_name = "BYTES")]
     pub memory_limit: Option<u64>,
+    #[command(flatten)]
+    pub checkpoint: CheckpointArgs,
+}
+
+/// Checkpoint and resume flags (shared by `render` and `radiosity`).
+#[derive(Args, Debug, Default)]
+pub struct CheckpointArgs {
+    /// Save the render's state to FILE at pass boundaries every --checkpoint-every
+    /// seconds, on SIGINT, SIGTERM or SIGHUP, and at the end; --resume FILE continues it.
+    #[arg(long, value_name = "FILE")]
+    pub checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints (at the first pass boundary after each interval).
+    #[arg(long, value_name = "SECONDS", default_value_t = 300.0, value_parser = parse_seconds)]
+    pub checkpoint_every: f64,
+    /// Continue from a checkpoint of the same scene and settings; the final image is
+    /// bit-identical to an uninterrupted render. Checkpoints go on to FILE unless
+    /// --checkpoint names another.
+    #[arg(long, value_name = "FILE")]
+    pub resume: Option<PathBuf>,
+    /// Stop (as if interrupted, saving the checkpoint) at the first pass boundary with
+    /// this many samples per pixel, iterations or shots done (for tests).
+    #[arg(long, value_name = "N", hide = true)]
+    pub stop_after: Option<u32>,
+}
+
+impl CheckpointArgs {
+    /// Where checkpoints are written, if anywhere.
+    pub fn target(&self) -> Option<&Path> {
+        self.checkpoint.as_deref().or(self.resume.as_deref())
+    }
+
+    /// Refuses, before any work, flags that cannot work together or a checkpoint path
+    /// that cannot be written.
+    pub fn check(&self) -> anyhow::Result<()> {
+        if self.stop_after.is_some() && self.target().is_none() {
+            bail!("--stop-after needs --checkpoint FILE");
+        }
+        if let Some(path) = self.target() {
+            radiant::image::atomic::check_writable(path)
+                .with_context(|| format!("cannot write the checkpoint {}", path.display()))?;
+        }
+        Ok(())
+    }
+
+    /// Reads the checkpoint to resume from, refusing one of another run.
+    pub fn load(&self, key: &RunKey) -> anyhow::Result<Option<checkpoint::State>> {
+        let Some(path) = &self.resume else {
+            return Ok(None);
+        };
+        let saved = checkpoint::read(path)
+            .with_context(|| format!("--resume {}: cannot read the checkpoint", path.display()))?;
+        saved
+            .key
+            .check(key)
+            .with_context(|| format!("--resume {}", path.display()))?;
+        Ok(Some(saved.state))
+    }
+}
+
+/// A positive, finite number of seconds.
+pub fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "expected a positive number of seconds, got \"{s}\""
+        )),
+    }
 }
 
 /// `16G`, `512M`, `1.5e9`: a number of bytes with an optional binary unit suffix.
@@ -131,6 +200,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if let Some(output) = &args.output {
         check_output(output)?;
     }
+    args.checkpoint.check()?;
     let threads = capped_threads(args.threads);
     if let Some(bytes) = args.memory_limit {
         radiant::render::budget::set_limit(bytes);
@@ -155,6 +225,28 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let session = Session::new(&desc, &overrides)?;
     for w in &session.warnings {
         eprintln!("{w}");
+    }
+    let ckpt = &args.checkpoint;
+    let key = ckpt.target().map(|_| session.run_key(&desc));
+    let resume = match &key {
+        Some(key) => match ckpt.load(key)? {
+            Some(checkpoint::State::Render(state)) => Some(state),
+            Some(other) => bail!(
+                "--resume: the checkpoint holds {} state, not a render's",
+                other.kind()
+            ),
+            None => None,
+        },
+        None => None,
+    };
+    if let Some(state) = &resume
+        && !args.quiet
+    {
+        eprintln!(
+            "resuming from {} spp (SPPM: iterations) of {}",
+            state.done(),
+            session.ctx.spp
+        );
     }
 
     let interrupts = Interrupts::install()?;
@@ -184,13 +276,49 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
                 snapshot_errors.push(format!("writing {}: {e}", path.display()));
             }
         };
-        let out = pool.install(|| session.render_with_snapshots(&progress, &mut snapshot));
+        let mut checkpoint_errors = Vec::new();
+        let mut last_checkpoint = std::time::Instant::now();
+        let every = Duration::from_secs_f64(ckpt.checkpoint_every);
+        let mut hook = |done: u32, state: &dyn Fn() -> IntegratorState| {
+            if ckpt.stop_after.is_some_and(|k| done >= k) {
+                // Saved with the interrupted render's state below.
+                return std::ops::ControlFlow::Break(());
+            }
+            if let (Some(path), Some(key)) = (ckpt.target(), &key)
+                && last_checkpoint.elapsed() >= every
+            {
+                let _writing = interrupts.writing();
+                if let Err(e) = checkpoint::write(path, key, &checkpoint::State::Render(state())) {
+                    checkpoint_errors.push(format!("writing {}: {e}", path.display()));
+                }
+                last_checkpoint = std::time::Instant::now();
+            }
+            std::ops::ControlFlow::Continue(())
+        };
+        let want_hook = key.is_some();
+        let out = pool.install(|| {
+            let hook = want_hook.then_some(&mut hook as &mut CheckpointHook<'_>);
+            session.render_resumable(&progress, &mut snapshot, resume, hook)
+        });
         bar_done.store(true, Ordering::SeqCst);
-        for e in snapshot_errors {
+        for e in snapshot_errors.iter().chain(&checkpoint_errors) {
             eprintln!("warning: {e}");
         }
         out
-    });
+    })?;
+
+    // The state goes to the checkpoint before the image: it is what an interrupted
+    // render cannot make again.
+    if let (Some(path), Some(key)) = (ckpt.target(), &key) {
+        if let Some(state) = output_data.state.clone() {
+            let _writing = interrupts.writing();
+            checkpoint::write(path, key, &checkpoint::State::Render(state))
+                .with_context(|| format!("writing the checkpoint {}", path.display()))?;
+            if !args.quiet || output_data.interrupted {
+                eprintln!("checkpoint: {}", path.display());
+            }
+        }
+    }
 
     // Stopped before every pixel had a sample (photon tracing, radiosity solve, the first
     // pass): such an image would pass for a black render, so the previous file stays.

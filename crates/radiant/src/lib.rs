@@ -15,6 +15,7 @@ pub use radiant_radiosity as radiosity;
 pub use radiant_render as render;
 pub use radiant_scene as scene;
 
+pub mod checkpoint;
 pub mod integrators;
 pub mod session;
 

@@ -2,14 +2,19 @@
 //! integrator it names (or the command line names).
 
 use radiant_image::Film;
+use radiant_render::integrator::{CheckpointHook, IntegratorState};
 use radiant_render::{Integrator, Overrides, Progress, RenderContext, RenderControl, RenderOutput};
 use radiant_scene::{SceneDesc, SceneError, Warning};
 
+use crate::checkpoint::{CheckpointError, RunKey, scene_hash, settings_hash};
 use crate::integrators::integrator_from_desc;
 
 pub struct Session {
     pub ctx: RenderContext,
     pub integrator: Box<dyn Integrator>,
+    /// Name and parameter hash of the integrator's description in effect (the
+    /// scene's, with an override's name), for checkpoints.
+    integrator_key: (String, u64),
     /// Warnings from preparing the session (the parser's are in the scene).
     pub warnings: Vec<Warning>,
 }
@@ -28,8 +33,25 @@ impl Session {
         Ok(Session {
             ctx,
             integrator,
+            integrator_key: (
+                integrator_desc.name.clone(),
+                settings_hash(&integrator_desc),
+            ),
             warnings,
         })
+    }
+
+    /// What identifies this render in a checkpoint (`desc` is the scene it was made
+    /// from).
+    pub fn run_key(&self, desc: &SceneDesc) -> RunKey {
+        RunKey {
+            scene: scene_hash(desc),
+            integrator: self.integrator_key.0.clone(),
+            settings: self.integrator_key.1,
+            seed: self.ctx.seed,
+            spp: self.ctx.spp,
+            resolution: self.ctx.resolution,
+        }
     }
 
     /// The integrator as its concrete type, when it is one (`session.integrator_as::<
@@ -53,5 +75,39 @@ impl Session {
     ) -> RenderOutput {
         self.integrator
             .render(&self.ctx, &mut RenderControl::new(progress, snapshot))
+    }
+
+    /// Renders the image from `resume` (a state of this session's integrator, checked
+    /// against the run by the caller with [`RunKey::check`]), calling `checkpoint` at
+    /// every pass boundary; an interrupted render returns its state to save.
+    pub fn render_resumable<'a>(
+        &self,
+        progress: &'a Progress,
+        snapshot: &'a mut dyn FnMut(u32, &Film),
+        resume: Option<IntegratorState>,
+        checkpoint: Option<&'a mut CheckpointHook<'a>>,
+    ) -> Result<RenderOutput, CheckpointError> {
+        if let Some(state) = &resume {
+            let wanted = self.integrator.state_kind();
+            if state.kind() != wanted {
+                return Err(CheckpointError::Kind {
+                    found: state.kind().name(),
+                    wanted: wanted.name(),
+                });
+            }
+            if state.resolution() != self.ctx.resolution {
+                return Err(CheckpointError::Payload(format!(
+                    "a {}x{} image for a {}x{} render",
+                    state.resolution().0,
+                    state.resolution().1,
+                    self.ctx.resolution.0,
+                    self.ctx.resolution.1
+                )));
+            }
+        }
+        let mut control = RenderControl::new(progress, snapshot);
+        control.resume = resume;
+        control.checkpoint = checkpoint;
+        Ok(self.integrator.render(&self.ctx, &mut control))
     }
 }

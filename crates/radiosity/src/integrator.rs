@@ -9,7 +9,8 @@ use std::time::Instant;
 use crate::mesh::meshed_scene::RadiosityScene;
 use crate::output::shading::Shading;
 use crate::settings::{RadiositySettings, VisibilitySource};
-use crate::solve::adaptive::{AdaptiveSolution, solve_adaptive};
+use crate::solve::adaptive::{AdaptiveSolution, solve_adaptive_from};
+use crate::solve::progressive::ProgressiveState;
 use crate::solve::{RadiosityError, RadiosityStats, SolveEvent};
 use crate::visibility::bvh::{FaceVisibility, SceneVisibility, WorldVisibility};
 use radiant_render::integrator::{Integrator, RenderControl, RenderOutput, Stats, render_passes};
@@ -108,17 +109,32 @@ pub fn solve_session_observed(
     scene: &RadiosityScene,
     settings: &RadiositySettings,
     progress: &Progress,
+    observe: impl FnMut(&SolveEvent<'_>),
+) -> Result<AdaptiveSolution, RadiosityError> {
+    solve_session_resumed(world, scene, settings, progress, None, observe)
+}
+
+/// [`solve_session_observed`] continuing from a saved progressive state (see
+/// [`solve_adaptive_from`]). The cancel flag is read before `observe` sees an event,
+/// so an observer that finds it set has seen the state the solve stops in.
+pub fn solve_session_resumed(
+    world: &World,
+    scene: &RadiosityScene,
+    settings: &RadiositySettings,
+    progress: &Progress,
+    resume: Option<&ProgressiveState>,
     mut observe: impl FnMut(&SolveEvent<'_>),
 ) -> Result<AdaptiveSolution, RadiosityError> {
     progress.total.store(1000, Ordering::Relaxed);
     progress.done.store(0, Ordering::Relaxed);
     let sphere = world.scene_sphere();
-    solve_adaptive(
+    solve_adaptive_from(
         scene,
         &world.lights,
         sphere,
         settings,
         |mesh| scene_visibility(mesh, world, settings),
+        resume,
         |event| {
             let done = match event {
                 SolveEvent::Shot { fraction_done, .. } => (1000.0 * fraction_done) as u64,
@@ -126,8 +142,9 @@ pub fn solve_session_observed(
                 SolveEvent::Sweep { .. } => 900,
             };
             progress.done.store(done, Ordering::Relaxed);
+            let stop = progress.cancelled();
             observe(&event);
-            if progress.cancelled() {
+            if stop {
                 ControlFlow::Break(())
             } else {
                 ControlFlow::Continue(())

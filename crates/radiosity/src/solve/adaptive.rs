@@ -15,7 +15,8 @@
 use std::collections::HashMap;
 use std::ops::ControlFlow;
 
-use super::{RadiosityError, Solution, SolveEvent, solve_from};
+use super::progressive::{ProgressiveState, Start};
+use super::{RadiosityError, Solution, SolveEvent, solve_start};
 use crate::mesh::meshed_scene::RadiosityScene;
 use crate::mesh::refinement::{RefinedScene, Refinement};
 use crate::output::display::SMOOTH_ANGLE_DEG;
@@ -125,6 +126,21 @@ pub fn solve_adaptive<V: Visibility>(
     sphere: SceneSphere,
     settings: &RadiositySettings,
     make_vis: impl Fn(&RadiosityScene) -> V,
+    on_event: impl FnMut(SolveEvent<'_>) -> ControlFlow<()>,
+) -> Result<AdaptiveSolution, RadiosityError> {
+    solve_adaptive_from(scene, lights, sphere, settings, make_vis, None, on_event)
+}
+
+/// [`solve_adaptive`] whose first solve continues from a saved progressive state (of
+/// the contact-graded mesh, before any refinement pass: a state saved in a later pass
+/// belongs to a mesh this does not rebuild).
+pub fn solve_adaptive_from<V: Visibility>(
+    scene: &RadiosityScene,
+    lights: &[Light],
+    sphere: SceneSphere,
+    settings: &RadiositySettings,
+    make_vis: impl Fn(&RadiosityScene) -> V,
+    resume: Option<&ProgressiveState>,
     mut on_event: impl FnMut(SolveEvent<'_>) -> ControlFlow<()>,
 ) -> Result<AdaptiveSolution, RadiosityError> {
     let start = std::time::Instant::now();
@@ -147,26 +163,32 @@ pub fn solve_adaptive<V: Visibility>(
         let vis = make_vis(mesh);
         let share = 1.0 / (passes + 1) as f64;
         let offset = done as f64 * share;
-        let solution = solve_from(
-            mesh,
-            lights,
-            sphere,
-            settings,
-            &vis,
-            guess.as_deref(),
-            |event| match event {
-                SolveEvent::Shot {
-                    scene,
-                    state,
-                    fraction_done,
-                } => on_event(SolveEvent::Shot {
-                    scene,
-                    state,
-                    fraction_done: offset + share * fraction_done,
-                }),
-                other => on_event(other),
-            },
-        )?;
+        let start_from = match (&guess, resume) {
+            (Some(g), _) => Start::Guess(g),
+            (None, Some(state)) => Start::Resume(state),
+            (None, None) => Start::Emission,
+        };
+        let solution =
+            solve_start(
+                mesh,
+                lights,
+                sphere,
+                settings,
+                &vis,
+                start_from,
+                |event| match event {
+                    SolveEvent::Shot {
+                        scene,
+                        state,
+                        fraction_done,
+                    } => on_event(SolveEvent::Shot {
+                        scene,
+                        state,
+                        fraction_done: offset + share * fraction_done,
+                    }),
+                    other => on_event(other),
+                },
+            )?;
         iterations += solution.iterations;
         let finish = |current: Option<RefinedScene>, mut solution: Solution, done| {
             // Shots and seconds of all passes (meshing included).

@@ -29,7 +29,7 @@ use thiserror::Error;
 use self::matrix_solvers::{IterationSettings, SolveError, solve_gauss_seidel, solve_jacobi};
 use self::progressive::{
     ProgressiveError, ProgressiveSettings, ProgressiveState, ShooterSelection, ShootingFactors,
-    solve_progressive_from,
+    Start, solve_progressive_start,
 };
 use crate::formfactor::hemicube::{HemiCube, HemiCubeError};
 use crate::formfactor::matrix::FormFactorMatrix;
@@ -267,6 +267,20 @@ pub fn solve_from<V: Visibility>(
     settings: &RadiositySettings,
     vis: &V,
     guess: Option<&[[f64; 3]]>,
+    on_event: impl FnMut(SolveEvent<'_>) -> ControlFlow<()>,
+) -> Result<Solution, RadiosityError> {
+    solve_start(scene, lights, sphere, settings, vis, guess.into(), on_event)
+}
+
+/// [`solve`] from the emission, a guess or a saved progressive state (progressive
+/// refinement only; the matrix solvers start from the emission as always).
+pub fn solve_start<V: Visibility>(
+    scene: &RadiosityScene,
+    lights: &[Light],
+    sphere: SceneSphere,
+    settings: &RadiositySettings,
+    vis: &V,
+    start_from: Start<'_>,
     mut on_event: impl FnMut(SolveEvent<'_>) -> ControlFlow<()>,
 ) -> Result<Solution, RadiosityError> {
     let start = Instant::now();
@@ -299,7 +313,7 @@ pub fn solve_from<V: Visibility>(
                 }
             };
             let log_tolerance = settings.tolerance.ln();
-            let report = solve_progressive_from(
+            let report = solve_progressive_start(
                 set,
                 factors,
                 vis,
@@ -309,7 +323,7 @@ pub fn solve_from<V: Visibility>(
                     selection: ShooterSelection::TotalPower,
                     callback_every: 1,
                 },
-                guess,
+                start_from,
                 |state| {
                     let fraction = state.unshot_fraction().max(f64::MIN_POSITIVE);
                     let fraction_done = (fraction.ln() / log_tolerance).clamp(0.0, 1.0);

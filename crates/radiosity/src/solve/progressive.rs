@@ -31,6 +31,27 @@ pub enum ProgressiveError {
     MatrixSize { patches: usize, matrix: usize },
     #[error("{patches} patches but a starting guess of {guess} radiosities")]
     GuessSize { patches: usize, guess: usize },
+    #[error("{patches} patches but a saved state of {state} patches")]
+    StateSize { patches: usize, state: usize },
+}
+
+/// Where a progressive solve starts.
+#[derive(Clone, Copy, Debug, Default)]
+pub enum Start<'a> {
+    /// `B = dB = E`.
+    #[default]
+    Emission,
+    /// A guess of the radiosities, primed as in [`solve_progressive_from`].
+    Guess(&'a [[f64; 3]]),
+    /// A state saved after some shots: the solve continues exactly as if it had never
+    /// stopped, since the next shooter and every shot depend on the state alone.
+    Resume(&'a ProgressiveState),
+}
+
+impl<'a> From<Option<&'a [[f64; 3]]>> for Start<'a> {
+    fn from(guess: Option<&'a [[f64; 3]]>) -> Start<'a> {
+        guess.map_or(Start::Emission, Start::Guess)
+    }
 }
 
 /// How the next shooter is chosen.
@@ -222,9 +243,33 @@ pub fn solve_progressive_from<V: Visibility>(
     vis: &V,
     settings: ProgressiveSettings,
     guess: Option<&[[f64; 3]]>,
+    on_progress: impl FnMut(&ProgressiveState) -> ControlFlow<()>,
+) -> Result<ProgressiveReport, ProgressiveError> {
+    solve_progressive_start(set, factors, vis, settings, guess.into(), on_progress)
+}
+
+/// [`solve_progressive`] from the emission, a guess, or a saved state.
+pub fn solve_progressive_start<V: Visibility>(
+    set: &PatchSet,
+    factors: ShootingFactors<'_>,
+    vis: &V,
+    settings: ProgressiveSettings,
+    start: Start<'_>,
     mut on_progress: impl FnMut(&ProgressiveState) -> ControlFlow<()>,
 ) -> Result<ProgressiveReport, ProgressiveError> {
     let n = set.len();
+    let guess = match start {
+        Start::Guess(g) => Some(g),
+        _ => None,
+    };
+    if let Start::Resume(s) = start
+        && [s.radiosity.len(), s.unshot.len(), s.irradiance.len()] != [n; 3]
+    {
+        return Err(ProgressiveError::StateSize {
+            patches: n,
+            state: s.radiosity.len(),
+        });
+    }
     if let ShooterSelection::Band(b) = settings.selection
         && b > 2
     {
@@ -246,7 +291,10 @@ pub fn solve_progressive_from<V: Visibility>(
             guess: g.len(),
         });
     }
-    let mut state = ProgressiveState::new(set);
+    let mut state = match start {
+        Start::Resume(s) => s.clone(),
+        _ => ProgressiveState::new(set),
+    };
     let mut fractions = Vec::new();
     let mut fractions_per_band = Vec::new();
     let mut shooting = Shooting {

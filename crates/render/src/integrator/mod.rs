@@ -15,6 +15,7 @@ pub mod path;
 pub mod photon;
 pub mod specular;
 pub mod sppm;
+pub mod state;
 
 use std::any::Any;
 use std::fmt;
@@ -23,6 +24,7 @@ pub use passes::{PixelEstimator, PixelId, render_passes};
 pub use path::{PathIntegrator, PathSettings};
 pub use photon::{PhotonMapIntegrator, PhotonMapStats, PhotonSettings, Visualize};
 pub use sppm::{SppmIntegrator, SppmSettings, SppmStats};
+pub use state::{CheckpointHook, IntegratorState, SppmPixel, StateKind};
 
 use crate::context::{Progress, RenderContext};
 use radiant_image::Film;
@@ -39,6 +41,12 @@ pub trait Integrator: Any + Send + Sync {
     /// actually received).
     fn render(&self, ctx: &RenderContext, control: &mut RenderControl<'_>) -> RenderOutput;
 
+    /// The kind of state it saves at checkpoints and resumes from
+    /// ([`RenderControl::resume`]).
+    fn state_kind(&self) -> StateKind {
+        StateKind::Film
+    }
+
     /// Renders to the end, unobserved.
     fn render_unobserved(&self, ctx: &RenderContext) -> RenderOutput {
         let progress = Progress::default();
@@ -52,11 +60,38 @@ pub struct RenderControl<'a> {
     /// Called with the film each time the samples per pixel (SPPM: iterations)
     /// completed in every pixel reach a power of two.
     pub snapshot: &'a mut dyn FnMut(u32, &Film),
+    /// A state to continue from (of the integrator's [`Integrator::state_kind`]; the
+    /// caller checks it belongs to the same scene and settings).
+    pub resume: Option<IntegratorState>,
+    /// Sees every pass boundary; when set, the render also returns its final state
+    /// ([`RenderOutput::state`]), finished or interrupted.
+    pub checkpoint: Option<&'a mut CheckpointHook<'a>>,
 }
 
 impl<'a> RenderControl<'a> {
     pub fn new(progress: &'a Progress, snapshot: &'a mut dyn FnMut(u32, &Film)) -> Self {
-        RenderControl { progress, snapshot }
+        RenderControl {
+            progress,
+            snapshot,
+            resume: None,
+            checkpoint: None,
+        }
+    }
+
+    /// Calls the checkpoint hook, if any, at a boundary with `done` samples per pixel.
+    pub fn boundary(&mut self, done: u32, state: &dyn Fn() -> IntegratorState) {
+        if let Some(hook) = self.checkpoint.as_mut()
+            && hook(done, state).is_break()
+        {
+            self.progress
+                .cancel
+                .store(true, std::sync::atomic::Ordering::SeqCst);
+        }
+    }
+
+    /// The state to return with an output, when checkpoints are asked for.
+    pub fn final_state(&self, state: impl FnOnce() -> IntegratorState) -> Option<IntegratorState> {
+        self.checkpoint.is_some().then(state)
     }
 }
 
@@ -68,6 +103,9 @@ pub struct RenderOutput {
     /// Samples per pixel (SPPM: iterations) completed in every pixel.
     pub spp_done: u32,
     pub interrupted: bool,
+    /// The state to resume from (or to save as the finished render's), when
+    /// checkpoints were asked for ([`RenderControl::checkpoint`]).
+    pub state: Option<IntegratorState>,
     /// What the integrator reports beyond the image (photon counts, radii, timings).
     pub stats: Stats,
 }

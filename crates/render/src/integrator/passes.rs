@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::{RenderControl, RenderOutput, Stats};
+use super::{IntegratorState, RenderControl, RenderOutput, Stats};
 use crate::context::{Progress, RenderContext};
 use crate::geometry::Ray;
 use crate::sampler::PixelSample;
@@ -43,7 +43,8 @@ pub trait PixelEstimator: Sync {
     ) -> (Rgb, u32);
 }
 
-/// Takes `ctx.spp` samples per pixel with `estimator` into a new film.
+/// Takes `ctx.spp` samples per pixel with `estimator` into a new film, or into the
+/// film of `control.resume`, continuing each pixel after the samples it has.
 pub fn render_passes<E: PixelEstimator>(
     ctx: &RenderContext,
     estimator: &E,
@@ -51,15 +52,40 @@ pub fn render_passes<E: PixelEstimator>(
 ) -> RenderOutput {
     let start = Instant::now();
     let progress = control.progress;
-    let mut film = ctx.new_film();
+    let mut film = match control.resume.take() {
+        Some(IntegratorState::Film(film))
+            if (film.width as u32, film.height as u32) == ctx.resolution =>
+        {
+            Film {
+                sensor: ctx.sensor,
+                ..film
+            }
+        }
+        _ => ctx.new_film(),
+    };
     let (w, h) = (film.width as u64, film.height as u64);
     progress
         .total
         .store(w * h * ctx.spp as u64, Ordering::Relaxed);
-    let mut spp_done = 0u32;
-    let mut pass = 1u32;
+    let taken: u64 = film
+        .pixels
+        .iter()
+        .map(|p| p.samples.min(ctx.spp) as u64)
+        .sum();
+    progress.done.fetch_add(taken, Ordering::Relaxed);
+    let mut spp_done = film.min_samples();
+    // The pass schedule of a fresh render (1, 1, 2, 4, … 64, 64, …), picked up where a
+    // resumed film left off; the image does not depend on it, the snapshots do.
+    let mut pass = if spp_done < 2 {
+        1
+    } else {
+        (1u32 << (31 - spp_done.leading_zeros())).min(64)
+    };
     while spp_done < ctx.spp && !progress.cancelled() {
-        let n = pass.min(ctx.spp - spp_done);
+        let mut n = pass.min(ctx.spp - spp_done);
+        if spp_done > 0 && !spp_done.is_power_of_two() {
+            n = n.min(spp_done.next_power_of_two() - spp_done);
+        }
         let nonfinite = render_pass(ctx, estimator, &mut film, spp_done, n, progress);
         film.nonfinite.merge(nonfinite);
         if progress.cancelled() {
@@ -69,21 +95,25 @@ pub fn render_passes<E: PixelEstimator>(
         if spp_done.is_power_of_two() {
             (control.snapshot)(spp_done, &film);
         }
+        control.boundary(spp_done, &|| IntegratorState::Film(film.clone()));
         if spp_done >= 2 {
             pass = (pass * 2).min(64);
         }
     }
+    let interrupted = progress.cancelled();
     RenderOutput {
         spp_done: film.min_samples(),
+        state: control.final_state(|| IntegratorState::Film(film.clone())),
         film,
         seconds: start.elapsed().as_secs_f64(),
         rays: progress.rays.load(Ordering::Relaxed),
-        interrupted: progress.cancelled(),
+        interrupted,
         stats: Stats::default(),
     }
 }
 
-/// Adds samples `first .. first + count` to every pixel.
+/// Adds samples `first .. first + count` to every pixel (those it does not have yet:
+/// a resumed film may hold some of them already).
 fn render_pass<E: PixelEstimator>(
     ctx: &RenderContext,
     estimator: &E,
@@ -102,14 +132,16 @@ fn render_pass<E: PixelEstimator>(
                 return nonfinite;
             }
             let mut rays = 0u64;
+            let mut row_samples = 0u64;
             let mut scratch = estimator.scratch();
             for (x, film_pixel) in row.iter_mut().enumerate() {
-                for index in first..first + count {
+                for index in film_pixel.samples.max(first)..first + count {
                     let pixel = PixelId {
                         x: x as u32,
                         y: y as u32,
                         index,
                     };
+                    row_samples += 1;
                     let (l, weight, r) = sample_pixel(ctx, estimator, &mut scratch, pixel);
                     rays += r as u64;
                     if l.is_finite() && weight.is_finite() {
@@ -124,9 +156,7 @@ fn render_pass<E: PixelEstimator>(
                 }
             }
             progress.rays.fetch_add(rays, Ordering::Relaxed);
-            progress
-                .done
-                .fetch_add(row.len() as u64 * count as u64, Ordering::Relaxed);
+            progress.done.fetch_add(row_samples, Ordering::Relaxed);
             nonfinite
         })
         .reduce(NonFinite::default, |mut a, b| {

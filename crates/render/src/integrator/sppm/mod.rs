@@ -31,7 +31,9 @@ pub use settings::SppmSettings;
 use super::footprint::pixel_footprint;
 use super::photon::trace::{PhotonPass, PhotonStream};
 use crate::context::RenderContext;
-use crate::integrator::{Integrator, RenderControl, RenderOutput, Stats};
+use crate::integrator::{
+    Integrator, IntegratorState, RenderControl, RenderOutput, SppmPixel, StateKind, Stats,
+};
 use hashgrid::HashGrid;
 use radiant_image::{Film, FilmPixel, NonFinite};
 use radiant_math::color::Rgb;
@@ -86,16 +88,7 @@ impl fmt::Display for SppmStats {
 }
 
 /// A pixel's progressive statistics (f64: thousands of iterations are summed).
-#[derive(Clone, Copy, Debug, Default)]
-struct PixelState {
-    /// Sum of direct light over iterations.
-    ld: [f64; 3],
-    /// Accumulated flux (times f and the camera throughput), rescaled with the radius.
-    tau: [f64; 3],
-    /// Accumulated photon count.
-    n: f64,
-    r2: f64,
-}
+type PixelState = SppmPixel;
 
 /// The default initial radius: [`DEFAULT_RADIUS_PIXELS`] pixel footprints at the
 /// distance of the scene's centre (or 1/100 of the scene's radius without one).
@@ -120,6 +113,10 @@ impl Integrator for SppmIntegrator {
 
     fn render(&self, ctx: &RenderContext, control: &mut RenderControl<'_>) -> RenderOutput {
         render(ctx, &self.settings, control)
+    }
+
+    fn state_kind(&self) -> StateKind {
+        StateKind::Sppm
     }
 }
 
@@ -147,21 +144,41 @@ fn render(
     progress
         .total
         .store(ctx.spp as u64 * n_pix as u64, Ordering::Relaxed);
-    let mut state = vec![
-        PixelState {
-            r2: radius as f64 * radius as f64,
-            ..Default::default()
-        };
-        n_pix
-    ];
+    let (mut state, first) = match control.resume.take() {
+        Some(IntegratorState::Sppm {
+            iterations,
+            width,
+            height,
+            pixels,
+        }) if (width, height) == ctx.resolution && pixels.len() == n_pix => (pixels, iterations),
+        _ => (
+            vec![
+                PixelState {
+                    r2: radius as f64 * radius as f64,
+                    ..Default::default()
+                };
+                n_pix
+            ],
+            0,
+        ),
+    };
+    progress
+        .done
+        .fetch_add(first.min(ctx.spp) as u64 * n_pix as u64, Ordering::Relaxed);
     let mut samples = vec![CameraSample::default(); n_pix];
     let mut spheres = vec![Vec4::ZERO; n_pix];
     let mut phi = vec![Rgb::BLACK; n_pix];
     let mut count = vec![0u32; n_pix];
     let world = &ctx.world;
     let mut film = ctx.new_film();
-    let mut done = 0u32;
-    for it in 0..ctx.spp {
+    let mut done = first;
+    let snapshot_state = |state: &[PixelState], done: u32| IntegratorState::Sppm {
+        iterations: done,
+        width: w as u32,
+        height: h as u32,
+        pixels: state.to_vec(),
+    };
+    for it in first..ctx.spp {
         if progress.cancelled() {
             break;
         }
@@ -269,17 +286,20 @@ fn render(
             write_estimates(&mut film, &state, done, n_photons);
             (control.snapshot)(done, &film);
         }
+        control.boundary(done, &|| snapshot_state(&state, done));
     }
     stats.iterations = done;
     let mean_r2 = state.iter().map(|s| s.r2).sum::<f64>() / n_pix.max(1) as f64;
     stats.final_radius = mean_r2.sqrt() as f32;
     write_estimates(&mut film, &state, done, n_photons);
+    let interrupted = done < ctx.spp;
     RenderOutput {
+        state: control.final_state(|| snapshot_state(&state, done)),
         film,
         seconds: start.elapsed().as_secs_f64(),
         rays: progress.rays.load(Ordering::Relaxed),
         spp_done: done,
-        interrupted: done < ctx.spp,
+        interrupted,
         stats: Stats::new(stats),
     }
 }
