@@ -211,35 +211,39 @@ pub struct Checkpoint {
     pub state: State,
 }
 
-/// Removes every `FileLoc { … }` (file, line and column of a directive) from a Debug
-/// rendering, so that the hash follows what the scene says, not where it says it.
+/// Removes every `FileLoc { … }` (file, line and column of a directive) and `Cell { … }`
+/// (whether a parameter was read yet) from a Debug rendering, so that the hash follows
+/// what the scene says, not where it says it or what has looked at it.
 fn strip_locations(text: &str) -> String {
-    const TAG: &str = "FileLoc {";
+    const TAGS: [&str; 2] = ["FileLoc {", "Cell {"];
+    let bytes = text.as_bytes();
     let mut out = String::with_capacity(text.len());
-    let mut rest = text;
-    while let Some(i) = rest.find(TAG) {
-        out.push_str(&rest[..i]);
-        // FileLoc holds a quoted file name and two numbers: skip to the brace that
-        // closes it, minding braces inside the quoted name.
-        let after = &rest[i + TAG.len()..];
-        let mut in_string = false;
-        let mut escaped = false;
-        let mut end = after.len();
-        for (k, c) in after.char_indices() {
+    let mut copied = 0;
+    let mut i = 0;
+    while i < bytes.len() {
+        let Some(tag) = TAGS.iter().find(|t| bytes[i..].starts_with(t.as_bytes())) else {
+            i += 1;
+            continue;
+        };
+        out.push_str(&text[copied..i]);
+        // Skip to the brace that closes it, minding braces inside a quoted file name.
+        let mut k = i + tag.len();
+        let (mut in_string, mut escaped) = (false, false);
+        while k < bytes.len() {
+            let c = bytes[k];
+            k += 1;
             match c {
                 _ if escaped => escaped = false,
-                '\\' if in_string => escaped = true,
-                '"' => in_string = !in_string,
-                '}' if !in_string => {
-                    end = k + 1;
-                    break;
-                }
+                b'\\' if in_string => escaped = true,
+                b'"' => in_string = !in_string,
+                b'}' if !in_string => break,
                 _ => {}
             }
         }
-        rest = &after[end.min(after.len())..];
+        i = k;
+        copied = k;
     }
-    out.push_str(rest);
+    out.push_str(&text[copied..]);
     out
 }
 
@@ -671,5 +675,8 @@ mod tests {
         let b = r#"Shape { kind: Sphere, loc: FileLoc { file: "b.pbrt", line: 9, column: 4 } }"#;
         assert_eq!(strip_locations(a), strip_locations(b));
         assert_eq!(strip_locations(a), "Shape { kind: Sphere, loc:  }");
+        let read = "Param { name: \"radius\", used: Cell { value: true } }";
+        let unread = "Param { name: \"radius\", used: Cell { value: false } }";
+        assert_eq!(strip_locations(read), strip_locations(unread));
     }
 }
