@@ -253,7 +253,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let progress = Arc::clone(&interrupts.progress);
     let pool = worker_pool(threads)?;
     let show_bar = !args.quiet && std::io::stderr().is_terminal();
-    let output_data = std::thread::scope(|scope| {
+    let mut output_data = std::thread::scope(|scope| {
         let bar_done = Arc::new(std::sync::atomic::AtomicBool::new(false));
         if show_bar {
             let progress = Arc::clone(&progress);
@@ -309,14 +309,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
 
     // The state goes to the checkpoint before the image: it is what an interrupted
     // render cannot make again.
-    if let (Some(path), Some(key)) = (ckpt.target(), &key) {
-        if let Some(state) = output_data.state.clone() {
-            let _writing = interrupts.writing();
-            checkpoint::write(path, key, &checkpoint::State::Render(state))
-                .with_context(|| format!("writing the checkpoint {}", path.display()))?;
-            if !args.quiet || output_data.interrupted {
-                eprintln!("checkpoint: {}", path.display());
-            }
+    if let (Some(path), Some(key), Some(state)) = (ckpt.target(), &key, output_data.state.take()) {
+        let _writing = interrupts.writing();
+        checkpoint::write(path, key, &checkpoint::State::Render(state))
+            .with_context(|| format!("writing the checkpoint {}", path.display()))?;
+        if !args.quiet || output_data.interrupted {
+            eprintln!("checkpoint: {}", path.display());
         }
     }
 
