@@ -413,7 +413,7 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, CheckpointError> {
     let payload_len = r.u64("the payload length")?;
     let payload_len = usize::try_from(payload_len)
         .map_err(|_| CheckpointError::Header(format!("payload of {payload_len} bytes")))?;
-    let payload = r.take(payload_len, "the contents")?;
+    let payload = r.take(payload_len, "the payload")?;
     let body_end = r.at;
     let sum = r.u64("the checksum")?;
     if r.at != bytes.len() {
