@@ -7,8 +7,8 @@ use libfuzzer_sys::fuzz_target;
 fuzz_target!(|data: &[u8]| {
     let _ = radiant_image::pfm::decode_pfm(data);
     let ext = match data.first() {
-        Some(0x76) => "exr",  // EXR magic 76 2f 31 01
-        Some(0x89) => "png",  // PNG magic 89 'P' 'N' 'G'
+        Some(0x76) => "exr", // EXR magic 76 2f 31 01
+        Some(0x89) => "png", // PNG magic 89 'P' 'N' 'G'
         _ => return,
     };
     let path = std::env::temp_dir().join(format!("radiant-fuzz-{}.{ext}", std::process::id()));
