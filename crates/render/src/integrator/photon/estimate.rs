@@ -34,6 +34,7 @@ impl PhotonMap {
     /// [`PhotonMap::build`], giving up (`None`) once `stop` holds.
     pub fn build_until(raw: Vec<RawPhoton>, stop: &(dyn Fn() -> bool + Sync)) -> Option<PhotonMap> {
         if stop() {
+            super::kdtree::release(raw);
             return None;
         }
         let scale = raw
@@ -47,10 +48,16 @@ impl PhotonMap {
         };
         let inv = 1.0 / scale;
         let photons: Vec<Photon> = raw.par_iter().map(|r| Photon::encode(r, inv)).collect();
+        super::kdtree::release(raw);
         Some(PhotonMap {
             tree: KdTree::build_until(photons, stop)?,
             power_scale: scale,
         })
+    }
+
+    /// Drops the map without waiting for a large one's memory to be returned.
+    pub fn discard(self) {
+        self.tree.discard();
     }
 
     /// Number of stored photons.

@@ -17,6 +17,8 @@
 
 use glam::Vec3;
 
+use rayon::prelude::*;
+
 use crate::geometry::Aabb;
 
 /// Items a [`KdTree`] can hold.
@@ -28,6 +30,12 @@ pub trait KdPoint {
 const PARALLEL_BUILD: usize = 16 * 1024;
 /// Nodes at least this large ask whether to stop before partitioning.
 const POLL_BUILD: usize = 4 * 1024;
+/// Ranges at least this large find their median by [`select_nth_polled`], which asks
+/// whether to stop while it partitions: one `select_nth_unstable` over 10^8 photons
+/// takes over a second, too long to wait for a cancelled render.
+const POLL_SELECT: usize = 1 << 22;
+/// Items partitioned between two questions to `stop` inside one selection.
+const POLL_STRIDE: usize = 1 << 16;
 
 /// Ranges this small are leaves: scanned in order, not split (contiguous in memory,
 /// cheaper than descending to single items).
@@ -171,22 +179,43 @@ fn sift_down(h: &mut [(f32, u32)], mut i: usize) {
     }
 }
 
-impl<T: KdPoint + Send> KdTree<T> {
+impl<T: KdPoint + Send + Sync + 'static> KdTree<T> {
     /// Builds the tree (reorders the items).
     pub fn build(items: Vec<T>) -> KdTree<T> {
         KdTree::build_until(items, &|| false).expect("never stopped")
     }
 
     /// [`KdTree::build`], giving up (`None`) once `stop` holds. `stop` is asked at every
-    /// node of at least [`POLL_BUILD`] items, so a stop takes effect within one
-    /// partition of that many items per thread (well under a millisecond).
+    /// node of at least [`POLL_BUILD`] items and every [`POLL_STRIDE`] items inside the
+    /// selections of large nodes, so a stop takes effect within milliseconds.
     pub fn build_until(mut items: Vec<T>, stop: &(dyn Fn() -> bool + Sync)) -> Option<KdTree<T>> {
-        let mut axes = vec![0u8; items.len()];
+        // Min and max are exact, so the parallel reduction gives the same box in any order.
         let bounds = items
-            .iter()
-            .fold(Aabb::EMPTY, |b, it| b.grow(it.position()));
+            .par_chunks(POLL_STRIDE)
+            .map(|chunk| {
+                if stop() {
+                    return Aabb::EMPTY;
+                }
+                chunk
+                    .iter()
+                    .fold(Aabb::EMPTY, |b, it| b.grow(it.position()))
+            })
+            .reduce(|| Aabb::EMPTY, |a, b| a.union(&b));
+        let mut axes = vec![0u8; items.len()];
         build_range(&mut items, &mut axes, bounds, stop);
-        (!stop()).then_some(KdTree { items, axes })
+        let tree = KdTree { items, axes };
+        if stop() {
+            tree.discard();
+            return None;
+        }
+        Some(tree)
+    }
+
+    /// Drops the tree without waiting for a large one's memory to be returned (see
+    /// [`release`]).
+    pub fn discard(self) {
+        release(self.items);
+        release(self.axes);
     }
 }
 
@@ -209,9 +238,15 @@ fn build_range<T: KdPoint + Send>(
         2
     };
     let mid = n / 2;
-    items.select_nth_unstable_by(mid, |a, b| {
-        a.position()[axis].total_cmp(&b.position()[axis])
-    });
+    if n >= POLL_SELECT {
+        if !select_nth_polled(items, mid, axis, stop) {
+            return;
+        }
+    } else {
+        items.select_nth_unstable_by(mid, |a, b| {
+            a.position()[axis].total_cmp(&b.position()[axis])
+        });
+    }
     axes[mid] = axis as u8;
     // Children's bounds: the parent's, clipped at the splitting plane (looser than the
     // exact bounds but free, and the axis choice only affects speed).
@@ -232,6 +267,82 @@ fn build_range<T: KdPoint + Send>(
         build_range(left, left_axes, left_b, stop);
         build_range(right, right_axes, right_b, stop);
     }
+}
+
+/// Drops a buffer given up on a stop. Returning gigabytes of pages to the system
+/// takes a good part of a second; a large buffer is freed on a thread of its own so
+/// that the stopping caller does not wait for it.
+pub fn release<T: Send + 'static>(buffer: Vec<T>) {
+    if buffer.len() * std::mem::size_of::<T>() >= 64 << 20 {
+        std::thread::spawn(move || drop(buffer));
+    }
+}
+
+/// Reorders `items` as `select_nth_unstable` does — `items[k]` is the k-th smallest
+/// along `axis`, none before it larger and none after it smaller — by quickselect
+/// (Hoare 1961) with three-way partitions (Dijkstra's Dutch flag, so that runs of equal
+/// coordinates, such as photons on an axis-aligned wall, end the search at once) around
+/// the median of nine evenly spaced items. Deterministic. Asks `stop` every
+/// [`POLL_STRIDE`] items and returns false, leaving the order unfinished, once it holds.
+/// Once the range is small, or when pivots keep failing to shrink it, the standard
+/// library's selection (linear in the worst case) finishes the work.
+fn select_nth_polled<T: KdPoint>(
+    items: &mut [T],
+    k: usize,
+    axis: usize,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> bool {
+    let key = |it: &T| it.position()[axis];
+    let (mut lo, mut hi) = (0, items.len());
+    let mut poor_rounds = 0;
+    while hi - lo >= POLL_SELECT && poor_rounds < 4 {
+        let range = &mut items[lo..hi];
+        let n = range.len();
+        let mut sample: [f32; 9] = std::array::from_fn(|i| key(&range[(2 * i + 1) * n / 18]));
+        sample.sort_unstable_by(f32::total_cmp);
+        let pivot = sample[4];
+        let (mut lt, mut i, mut gt) = (0, 0, n);
+        let mut since_poll = 0;
+        while i < gt {
+            match key(&range[i]).total_cmp(&pivot) {
+                std::cmp::Ordering::Less => {
+                    range.swap(lt, i);
+                    lt += 1;
+                    i += 1;
+                }
+                std::cmp::Ordering::Greater => {
+                    gt -= 1;
+                    range.swap(i, gt);
+                }
+                std::cmp::Ordering::Equal => i += 1,
+            }
+            since_poll += 1;
+            if since_poll == POLL_STRIDE {
+                since_poll = 0;
+                if stop() {
+                    return false;
+                }
+            }
+        }
+        let k_in = k - lo;
+        let kept = if k_in < lt {
+            hi = lo + lt;
+            lt
+        } else if k_in >= gt {
+            lo += gt;
+            n - gt
+        } else {
+            return true;
+        };
+        if kept > n - n / 8 {
+            poor_rounds += 1;
+        }
+    }
+    if stop() {
+        return false;
+    }
+    items[lo..hi].select_nth_unstable_by(k - lo, |a, b| key(a).total_cmp(&key(b)));
+    true
 }
 
 impl<T: KdPoint> KdTree<T> {
@@ -499,5 +610,32 @@ mod tests {
         let (a, b) = (build(1), build(3));
         assert_eq!(a.items, b.items);
         assert_eq!(a.axes, b.axes);
+    }
+
+    /// The polled selection keeps `select_nth_unstable`'s contract on a range large
+    /// enough to use it, with a third of the items on one plane (ties), and gives up
+    /// when asked to stop.
+    #[test]
+    fn polled_selection_partitions_like_select_nth() {
+        let mut rng = radiant_math::hash::Pcg32::new(5, 1);
+        let n = POLL_SELECT + POLL_SELECT / 4;
+        let raw: Vec<(f32, f32, f32)> = (0..n)
+            .map(|i| {
+                let x = if i % 3 == 0 { 0.25 } else { rng.uniform() };
+                (x, rng.uniform(), 0.0)
+            })
+            .collect();
+        for k in [0, n / 3, n / 2, n - 1] {
+            let mut items = points(&raw);
+            assert!(select_nth_polled(&mut items, k, 0, &|| false));
+            let v = items[k].position().x;
+            let mut keys: Vec<f32> = raw.iter().map(|p| p.0).collect();
+            keys.sort_unstable_by(f32::total_cmp);
+            assert_eq!(v, keys[k], "k = {k}");
+            assert!(items[..k].iter().all(|p| p.position().x <= v));
+            assert!(items[k + 1..].iter().all(|p| p.position().x >= v));
+        }
+        let mut items = points(&raw);
+        assert!(!select_nth_polled(&mut items, n / 2, 0, &|| true));
     }
 }

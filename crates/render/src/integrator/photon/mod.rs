@@ -197,9 +197,23 @@ impl PhotonMaps {
         // give up, leaving the maps empty.
         let stop = || progress.cancelled();
         let t1 = Instant::now();
-        let built = PhotonMap::build_until(global_raw, &stop)
-            .and_then(|g| Some((g, PhotonMap::build_until(caustic_raw, &stop)?)));
-        let (global, caustic) = built.unwrap_or_default();
+        let global = PhotonMap::build_until(global_raw, &stop);
+        let caustic = match global {
+            Some(_) => PhotonMap::build_until(caustic_raw, &stop),
+            None => {
+                kdtree::release(caustic_raw);
+                None
+            }
+        };
+        let (global, caustic) = match (global, caustic) {
+            (Some(g), Some(c)) => (g, c),
+            (g, _) => {
+                if let Some(g) = g {
+                    g.discard();
+                }
+                Default::default()
+            }
+        };
         stats.build_seconds = t1.elapsed().as_secs_f64();
         stats.global_stored = global.len() as u64;
         stats.caustic_stored = caustic.len() as u64;
