@@ -7,6 +7,7 @@
 pub mod builtin;
 pub mod desc;
 pub mod error;
+pub mod gz;
 pub mod mesh;
 pub mod named_spectra;
 pub mod obj;
@@ -14,6 +15,7 @@ pub mod params;
 pub mod parser;
 pub mod ply;
 pub mod spectrum;
+pub mod subdiv;
 pub mod token;
 
 pub use desc::*;

@@ -55,20 +55,17 @@ pub fn first_out_of_range(indices: &[u32], vertex_count: usize) -> Option<(usize
         .find(|&(_, i)| i as usize >= vertex_count)
 }
 
-/// Checks a mesh's data: finite positions, normals and uvs with one entry per vertex,
-/// indices in range. Returns a message naming the offending element.
+/// Checks a mesh's data: finite positions and uvs, one normal and uv per vertex,
+/// indices in range (non-finite or zero normals are mended by [`repair_normals`]). Returns a message naming the offending element.
 pub fn validate(mesh: &MeshData) -> Result<(), String> {
     let n = mesh.positions.len();
     if let Some((i, p)) = first_non_finite3(&mesh.positions) {
         return Err(format!("vertex {i} has a non-finite position {p}"));
     }
-    if let Some(normals) = &mesh.normals {
-        if normals.len() != n {
-            return Err(format!("{} normals for {n} vertices", normals.len()));
-        }
-        if let Some((i, v)) = first_non_finite3(normals) {
-            return Err(format!("vertex {i} has a non-finite normal {v}"));
-        }
+    if let Some(normals) = &mesh.normals
+        && normals.len() != n
+    {
+        return Err(format!("{} normals for {n} vertices", normals.len()));
     }
     if let Some(uvs) = &mesh.uvs {
         if uvs.len() != n {
@@ -87,6 +84,51 @@ pub fn validate(mesh: &MeshData) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// Replaces each non-finite or zero vertex normal by the area-weighted normal of the
+/// triangles and quads around the vertex (the geometric normal there; +z for a vertex
+/// no face uses), as pbrt-v4 renders such meshes rather than refusing them. Returns how
+/// many normals were replaced. Quads are taken as their two triangles (p00 p10 p11,
+/// p00 p11 p01).
+pub fn repair_normals(
+    positions: &[Vec3],
+    triangles: &[u32],
+    quads: &[u32],
+    normals: &mut [Vec3],
+) -> usize {
+    let bad = |n: Vec3| !n.is_finite() || n == Vec3::ZERO;
+    if !normals.iter().any(|&n| bad(n)) {
+        return 0;
+    }
+    let mut sum = vec![Vec3::ZERO; normals.len()];
+    let mut add = |a: u32, b: u32, c: u32| {
+        let (pa, pb, pc) = (
+            positions[a as usize],
+            positions[b as usize],
+            positions[c as usize],
+        );
+        // Twice the area times the unit normal: area weighting for free.
+        let n = (pb - pa).cross(pc - pa);
+        for v in [a, b, c] {
+            sum[v as usize] += n;
+        }
+    };
+    for t in triangles.chunks_exact(3) {
+        add(t[0], t[1], t[2]);
+    }
+    for q in quads.chunks_exact(4) {
+        add(q[0], q[1], q[3]);
+        add(q[0], q[3], q[2]);
+    }
+    let mut replaced = 0;
+    for (n, s) in normals.iter_mut().zip(sum) {
+        if bad(*n) {
+            *n = s.try_normalize().unwrap_or(Vec3::Z);
+            replaced += 1;
+        }
+    }
+    replaced
 }
 
 /// Area of the bilinear patch (p00, p10, p01, p11): the integral of |∂p/∂u × ∂p/∂v|
@@ -128,6 +170,22 @@ mod tests {
         m.triangles.truncate(3);
         m.positions[2].y = f32::NAN;
         assert!(validate(&m).unwrap_err().contains("vertex 2"));
+    }
+
+    #[test]
+    fn bad_normals_become_the_faces_normal() {
+        let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(0.0, 0.0, 1.0)];
+        // Two triangles meeting at vertices 0 and 1: one in z = 0, one in y = 0.
+        let triangles = [0, 1, 2, 0, 3, 1];
+        let mut normals = [Vec3::NAN, Vec3::ZERO, Vec3::new(0.0, 0.0, 2.0), Vec3::Y];
+        assert_eq!(repair_normals(&positions, &triangles, &[], &mut normals), 2);
+        // Equal areas: the mean of +z and +y.
+        let expect = Vec3::new(0.0, 1.0, 1.0).normalize();
+        assert!((normals[0] - expect).length() < 1e-6, "{}", normals[0]);
+        assert!((normals[1] - expect).length() < 1e-6);
+        // Good normals stay as they were, unnormalized ones too.
+        assert_eq!(normals[2], Vec3::new(0.0, 0.0, 2.0));
+        assert_eq!(normals[3], Vec3::Y);
     }
 
     #[test]

@@ -4,9 +4,9 @@
 //! Vertex properties: `x y z`, optional `nx ny nz`, optional texture coordinates named
 //! `u v`, `s t`, `texture_u texture_v` or `texture_s texture_t`. Faces: a list property
 //! `vertex_indices` (or `vertex_index`). Triangles stay triangles, quads become bilinear
-//! patches (as pbrt-v4 does), larger polygons are split into fans.
+//! patches (as pbrt-v4 does), larger polygons are split into fans. Gzip-compressed
+//! files (`.ply.gz`) are read as they are.
 
-use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
@@ -104,7 +104,7 @@ fn has_uv(def: &ElementDef) -> bool {
 /// vertex data and out-of-range indices are errors naming the element.
 pub fn read_ply(path: &Path) -> Result<MeshData, SceneError> {
     let fail = |message: String| SceneError::file(path, message);
-    let file = File::open(path).map_err(|e| fail(format!("cannot open PLY file: {e}")))?;
+    let file = crate::gz::open(path).map_err(|e| fail(format!("cannot open PLY file: {e}")))?;
     let mut reader = Reader::new(BufReader::new(file));
     let vertex_parser = Parser::<PlyVertex>::new();
     let header = vertex_parser

@@ -109,7 +109,10 @@ pub(crate) fn read_text(path: &Path) -> Result<String, ReadError> {
         return Err(too_large());
     }
     let mut bytes = Vec::with_capacity(meta.len() as usize);
-    file.take(MAX_SCENE_FILE_BYTES + 1)
+    // The limit applies to the text, so a small gzip file cannot expand without bound.
+    crate::gz::open_file(file)
+        .map_err(ReadError::Io)?
+        .take(MAX_SCENE_FILE_BYTES + 1)
         .read_to_end(&mut bytes)
         .map_err(ReadError::Io)?;
     if bytes.len() as u64 > MAX_SCENE_FILE_BYTES {

@@ -5,7 +5,10 @@
 //!   and ignored with a warning.
 //! - `"bilinearmesh"`: `P`, `indices` (four per patch: p00 p10 p01 p11; may be omitted
 //!   for exactly four vertices), `N`, `uv`.
-//! - `"plymesh"`, `"objmesh"`: `string filename`, relative to the scene file.
+//! - `"plymesh"`, `"objmesh"`: `string filename`, relative to the scene file (PLY may be
+//!   gzip-compressed).
+//! - `"loopsubdiv"`: `P`, `indices`, `integer levels` (default 3): subdivided at load
+//!   time into a triangle mesh on the limit surface (see [`crate::subdiv`]).
 //! - `"sphere"`: `radius` 1, `zmin` -radius, `zmax` radius, `phimax` 360.
 //! - `"disk"`: `height` 0, `radius` 1, `innerradius` 0, `phimax` 360.
 //!
@@ -20,15 +23,16 @@ use super::Parser;
 use super::state::with_defaults;
 use crate::desc::{AreaLightDesc, Geometry, ShapeDesc};
 use crate::error::{FileLoc, SceneError};
-use crate::mesh::{MeshData, first_non_finite2, first_non_finite3, first_out_of_range};
+use crate::mesh::{
+    MeshData, first_non_finite2, first_non_finite3, first_out_of_range, repair_normals,
+};
 use crate::params::{ParamSet, ParamValue};
-use crate::{obj, ply};
+use crate::{obj, ply, subdiv};
 
 /// pbrt-v4 shapes radiant does not render.
-const SKIPPED_SHAPES: [&str; 7] = [
+const SKIPPED_SHAPES: [&str; 6] = [
     "curve",
     "cylinder",
-    "loopsubdiv",
     "cone",
     "paraboloid",
     "hyperboloid",
@@ -51,8 +55,9 @@ impl Parser {
         ps.lookup("emissionfilename");
         let geometries = match name.as_str() {
             "trianglemesh" => vec![self.triangle_mesh(&ps, loc, &owner)?],
-            "bilinearmesh" => vec![bilinear_mesh(&ps, loc)?],
+            "bilinearmesh" => vec![self.bilinear_mesh(&ps, loc, &owner)?],
             "plymesh" | "objmesh" => self.mesh_file(&name, &ps, loc, &owner)?,
+            "loopsubdiv" => vec![loop_subdivision(&ps, loc)?],
             "sphere" => vec![sphere(&ps, loc)?],
             "disk" => vec![disk(&ps, loc)?],
             _ if SKIPPED_SHAPES.contains(&name.as_str()) => {
@@ -128,6 +133,7 @@ impl Parser {
         owner: &str,
     ) -> Result<Geometry, SceneError> {
         let (positions, indices, normals, uvs) = mesh_params(ps, loc, 3)?;
+        let normals = self.mend_normals(owner, &positions, &indices, &[], normals);
         for extra in ["S", "faceIndices"] {
             if let Some(p) = ps.lookup(extra) {
                 let at = p.loc.clone();
@@ -140,6 +146,46 @@ impl Parser {
             normals,
             uvs,
         })
+    }
+
+    fn bilinear_mesh(
+        &mut self,
+        ps: &ParamSet,
+        loc: &FileLoc,
+        owner: &str,
+    ) -> Result<Geometry, SceneError> {
+        let (positions, indices, normals, uvs) = mesh_params(ps, loc, 4)?;
+        let normals = self.mend_normals(owner, &positions, &[], &indices, normals);
+        Ok(Geometry::BilinearMesh {
+            positions,
+            indices,
+            normals,
+            uvs,
+        })
+    }
+
+    /// Non-finite or zero normals become the faces' geometric normal at their vertex,
+    /// with one warning for the mesh.
+    fn mend_normals(
+        &mut self,
+        owner: &str,
+        positions: &[Vec3],
+        triangles: &[u32],
+        quads: &[u32],
+        normals: NormalsAt,
+    ) -> Option<Vec<Vec3>> {
+        let (mut normals, at) = normals?;
+        let mended = repair_normals(positions, triangles, quads, &mut normals);
+        if mended > 0 {
+            self.warn(
+                &at,
+                format!(
+                    "{owner}: {mended} of {} normals are not finite or zero; the faces' geometric normal is used there",
+                    normals.len()
+                ),
+            );
+        }
+        Some(normals)
     }
 
     fn mesh_file(
@@ -174,7 +220,14 @@ impl Parser {
         } else {
             obj::read_obj(&path)
         };
-        let mesh = read.map_err(|e| at_param(e, &at, &path))?;
+        let mut mesh = read.map_err(|e| at_param(e, &at, &path))?;
+        mesh.normals = self.mend_normals(
+            owner,
+            &mesh.positions,
+            &mesh.triangles,
+            &mesh.quads,
+            mesh.normals.take().map(|n| (n, at.clone())),
+        );
         if mesh.polygons_split > 0 {
             self.warn(
                 &at,
@@ -228,7 +281,9 @@ fn mesh_geometries(mesh: MeshData) -> Vec<Geometry> {
     out
 }
 
-type MeshParams = (Vec<Vec3>, Vec<u32>, Option<Vec<Vec3>>, Option<Vec<Vec2>>);
+/// Normals as read, with the location of their parameter (for the repair warning).
+type NormalsAt = Option<(Vec<Vec3>, FileLoc)>;
+type MeshParams = (Vec<Vec3>, Vec<u32>, NormalsAt, Option<Vec<Vec2>>);
 
 /// `P`, `indices` (`per` per primitive), `N`, `uv`, validated.
 fn mesh_params(ps: &ParamSet, loc: &FileLoc, per: usize) -> Result<MeshParams, SceneError> {
@@ -287,13 +342,7 @@ fn mesh_params(ps: &ParamSet, loc: &FileLoc, per: usize) -> Result<MeshParams, S
                     format!("\"N\": {} normals for {n} vertices", normals.len()),
                 ));
             }
-            if let Some((i, v)) = first_non_finite3(normals) {
-                return Err(SceneError::at(
-                    n_loc,
-                    format!("\"N\": normal {i} is not finite ({v})"),
-                ));
-            }
-            Some(normals.to_vec())
+            Some((normals.to_vec(), n_loc.clone()))
         }
     };
     let uvs = uv_param(ps, n)?;
@@ -336,13 +385,50 @@ fn uv_param(ps: &ParamSet, n: usize) -> Result<Option<Vec<Vec2>>, SceneError> {
     Ok(Some(uvs))
 }
 
-fn bilinear_mesh(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
-    let (positions, indices, normals, uvs) = mesh_params(ps, loc, 4)?;
-    Ok(Geometry::BilinearMesh {
-        positions,
-        indices,
-        normals,
-        uvs,
+/// More triangles than this from one `loopsubdiv` is surely a wrong `levels` (it would
+/// take tens of gigabytes).
+const MAX_SUBDIVIDED_TRIANGLES: u128 = 1 << 27;
+
+fn loop_subdivision(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
+    let levels = match ps.ints("levels")? {
+        None => 3,
+        Some(([l], at)) => u32::try_from(*l)
+            .map_err(|_| SceneError::at(at, format!("\"levels\" must be at least 0, not {l}")))?,
+        Some((_, at)) => return Err(SceneError::at(at, "\"levels\" needs one value")),
+    };
+    let (positions, indices, normals, uvs) = mesh_params(ps, loc, 3)?;
+    if let Some((_, at)) = normals {
+        return Err(SceneError::at(
+            &at,
+            "\"N\" is not a parameter of \"loopsubdiv\" (normals come from the limit surface)",
+        ));
+    }
+    if uvs.is_some() {
+        let at = ps
+            .lookup("uv")
+            .or_else(|| ps.lookup("st"))
+            .map(|p| p.loc.clone());
+        return Err(SceneError::at(
+            at.as_ref().unwrap_or(loc),
+            "\"uv\" is not a parameter of \"loopsubdiv\"",
+        ));
+    }
+    let count = subdiv::triangle_count(indices.len() / 3, levels);
+    if count > MAX_SUBDIVIDED_TRIANGLES {
+        let at = ps.lookup("levels").map_or(loc, |p| &p.loc).clone();
+        return Err(SceneError::at(
+            &at,
+            format!(
+                "\"levels\" {levels} would make {count} triangles (at most {MAX_SUBDIVIDED_TRIANGLES})"
+            ),
+        ));
+    }
+    let s = subdiv::loop_subdivide(&positions, &indices, levels);
+    Ok(Geometry::TriangleMesh {
+        positions: s.positions,
+        indices: s.indices,
+        normals: Some(s.normals),
+        uvs: None,
     })
 }
 
