@@ -595,6 +595,42 @@ fn oversized_requests_fail_with_a_located_estimate() {
     }
 }
 
+/// Geometry is counted before the world and its BVH are built: a mesh that would take
+/// more than the budget stops the run at that shape's location, naming the count.
+#[test]
+fn geometry_over_the_budget_fails_at_the_shape() {
+    let dir = temp_dir("geometry-budget");
+    // 8 · 4^5 = 8192 triangles: about 0.8 MB by the estimate.
+    let scene = write_scene(
+        &dir,
+        "mesh.pbrt",
+        &format!(
+            "{CAMERA}WorldBegin\nLightSource \"point\" \"point3 from\" [0 0 5]\n\
+             Shape \"sphere\"\n\
+             Shape \"loopsubdiv\" \"integer levels\" 5 \"point3 P\" [1 0 0 -1 0 0 0 1 0 0 -1 0 0 0 1 0 0 -1]\n\
+             \"integer indices\" [0 2 4 2 1 4 1 3 4 3 0 4 2 0 5 1 2 5 3 1 5 0 3 5]\n"
+        ),
+    );
+    let out = dir.join("out.exr");
+    let run = |limit: &str| {
+        radiant()
+            .args(["render", "--quiet", "--memory-limit", limit, "-o"])
+            .arg(&out)
+            .arg(&scene)
+            .output()
+            .unwrap()
+    };
+    let result = run("500K");
+    let stderr = assert_clean_failure(&result, "a mesh over the budget");
+    assert!(
+        stderr
+            .contains("mesh.pbrt:7:1: error: 8193 primitives up to this shape would need ≈ 787 kB"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+    assert!(run("100M").status.success());
+}
+
 /// A dense solve over about 10^4 patches spends minutes on its form factors; they are
 /// computed in blocks of rows that each ask for cancellation, so a signal ends the run
 /// within a second (process exit included) and the previous image stays.

@@ -102,12 +102,19 @@ fn image_seeds_decode_and_truncations_fail() {
     }
 }
 
-/// PLY seeds read as meshes or fail with an error naming the file.
+/// PLY and OBJ seeds read as meshes or fail with an error naming the file.
 #[test]
-fn ply_seeds_read_or_fail_named() {
+fn mesh_seeds_read_or_fail_named() {
     let mut read = 0;
-    for path in seeds("ply_read") {
-        match radiant::scene::ply::read_ply(&path) {
+    let ply = seeds("ply_read").into_iter().map(|p| (p, true));
+    let obj = seeds("obj_read").into_iter().map(|p| (p, false));
+    for (path, is_ply) in ply.chain(obj) {
+        let mesh = if is_ply {
+            radiant::scene::ply::read_ply(&path)
+        } else {
+            radiant::scene::obj::read_obj(&path)
+        };
+        match mesh {
             Ok(mesh) => {
                 assert!(
                     !(mesh.triangles.is_empty() && mesh.quads.is_empty()),
@@ -119,5 +126,5 @@ fn ply_seeds_read_or_fail_named() {
             Err(e) => assert!(e.to_string().contains(&name(&path)), "{e}"),
         }
     }
-    assert!(read >= 3);
+    assert!(read >= 5, "only {read} mesh seeds read");
 }

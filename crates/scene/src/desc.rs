@@ -312,6 +312,15 @@ pub fn sphere_z_range(radius: f32, z_min: f32, z_max: f32) -> (f32, f32) {
 }
 
 impl Geometry {
+    /// Primitives the geometry becomes: triangles, bilinear patches, or one quadric.
+    pub fn primitive_count(&self) -> u64 {
+        match self {
+            Geometry::TriangleMesh { indices, .. } => indices.len() as u64 / 3,
+            Geometry::BilinearMesh { indices, .. } => indices.len() as u64 / 4,
+            Geometry::Sphere { .. } | Geometry::Disk { .. } => 1,
+        }
+    }
+
     /// Surface area in render space. Meshes are measured after the transform; spheres
     /// and disks by their object-space formula times the transform's mean area scale
     /// |det|^(2/3) (exact for uniform scales). Used for light `power` and default patch sizes.

@@ -25,6 +25,7 @@ impl World {
     /// Builds the render-ready world. Returns warnings for things that work only
     /// approximately (they are never silent).
     pub fn build(desc: &SceneDesc) -> Result<(World, Vec<Warning>), BuildError> {
+        check_capacity(desc)?;
         let mut warnings = Vec::new();
         let materials: Vec<Material> = desc.materials.iter().map(Material::from_desc).collect();
         let mut lights = Vec::new();
@@ -161,6 +162,42 @@ fn is_similarity(xf: &Transform) -> bool {
 }
 
 /// Adds one shape's primitives; area lights go to `lights` (None inside prototypes).
+/// Primitive ids are u32 (BVH leaves, hit records); one id stays free as a marker.
+const MAX_PRIMITIVES: u64 = u32::MAX as u64 - 1;
+/// A lower estimate of the memory one primitive takes once built: its vertices and
+/// per-primitive record, its reference and share of BVH nodes (measured at about 150
+/// bytes per triangle of a 2-million-triangle mesh, scene description excluded).
+const BYTES_PER_PRIMITIVE: f64 = 96.0;
+
+/// Before anything is built: the primitives of all shapes must fit the BVH's ids and
+/// the memory budget; otherwise a located error at the shape where the count goes over.
+fn check_capacity(desc: &SceneDesc) -> Result<(), BuildError> {
+    let mut primitives = 0u64;
+    let shapes = desc
+        .objects
+        .iter()
+        .flat_map(|o| o.shapes.iter())
+        .chain(&desc.shapes);
+    for shape in shapes {
+        primitives += shape.geometry.primitive_count();
+        if primitives > MAX_PRIMITIVES {
+            return Err(SceneError::at(
+                &shape.loc,
+                format!(
+                    "the scene reaches {primitives} primitives here, more than the BVH's capacity of {MAX_PRIMITIVES}"
+                ),
+            ));
+        }
+        if let Err(over) = crate::budget::check(primitives as f64 * BYTES_PER_PRIMITIVE) {
+            return Err(SceneError::at(
+                &shape.loc,
+                format!("{primitives} primitives up to this shape would need {over}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn add_shape(
     set: &mut ShapeSet,
     shape: &ShapeDesc,
