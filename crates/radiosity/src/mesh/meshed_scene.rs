@@ -112,16 +112,6 @@ impl RadiosityScene {
                 message: "radiosity: specular and glossy materials (mirror, glass, metal, rough metal and glass) have no diffuse part; their patches absorb all light".into(),
             });
         }
-        for light in &desc.lights {
-            if let LightDesc::Infinite { loc, .. } = light {
-                warnings.push(Warning {
-                    loc: loc.clone(),
-                    message:
-                        "radiosity: infinite (environment) lights are not supported and are ignored"
-                            .into(),
-                });
-            }
-        }
 
         let total_area: f64 = shapes
             .iter()
