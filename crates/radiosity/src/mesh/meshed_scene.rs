@@ -14,7 +14,7 @@ use super::face_mesh::{FaceMesh, Subdivision};
 use super::patch::PatchSet;
 use crate::settings::{DEFAULT_PATCH_COUNT, RadiositySettings, SolverKind};
 use radiant_scene::{
-    Geometry, LightDesc, MaterialDesc, SceneDesc, SceneError, ShapeDesc, Warning, sphere_z_range,
+    Geometry, MaterialDesc, SceneDesc, SceneError, ShapeDesc, Warning, sphere_z_range,
 };
 
 /// What every patch of one input face carries.
