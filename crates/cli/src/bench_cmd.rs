@@ -2,7 +2,7 @@
 
 use clap::Args;
 use radiant::render::accel::{RayBenchConfig, ray_benchmark};
-use radiant::render::bench::{render_benchmark, world_ray_benchmark};
+use radiant::render::bench::{environment_benchmark, render_benchmark, world_ray_benchmark};
 use radiant::render::integrator::photon::bench::photon_benchmark;
 use radiant::scene::builtin::cornell_box;
 
@@ -44,6 +44,11 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         println!(
             "{seconds:.2} s wall on {} threads",
             rayon::current_num_threads()
+        );
+        println!("== environment light sampling, sky with a small sun");
+        println!(
+            "{}",
+            environment_benchmark(512, if args.quick { 200_000 } else { 2_000_000 })
         );
         println!("== photon mapping, cornell-caustics");
         println!("{}", photon_benchmark(args.quick));

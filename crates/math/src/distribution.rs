@@ -1,5 +1,9 @@
 //! A piecewise-constant 1D distribution, used for discrete choices such as picking a
-//! light in proportion to its power or a triangle in proportion to its area.
+//! light in proportion to its power or a triangle in proportion to its area, and a
+//! piecewise-constant 2D density over the unit square built from it (marginal over
+//! rows, then the chosen row's conditional), used for environment images.
+
+use glam::Vec2;
 
 /// Discrete distribution over `n` items with weights `w_i >= 0`. Sampling inverts the
 /// CDF by binary search, so sampling is O(log n) and exactly reproducible.
@@ -83,9 +87,116 @@ impl Distribution1D {
     }
 }
 
+/// A piecewise-constant density over [0,1]² on a `width` x `height` grid of cells,
+/// proportional to non-negative cell weights (row 0 at v = 0). Sampling picks a row by
+/// the marginal distribution and a column by that row's conditional, then a uniform
+/// point within the cell: the density is `width * height * weight / total`. All-zero
+/// weights give the uniform density.
+#[derive(Clone, Debug, Default)]
+pub struct Distribution2D {
+    width: usize,
+    height: usize,
+    rows: Vec<Distribution1D>,
+    marginal: Distribution1D,
+}
+
+impl Distribution2D {
+    /// `weights` row-major, `width * height` of them (both at least 1).
+    pub fn new(weights: &[f32], width: usize, height: usize) -> Distribution2D {
+        assert!(
+            width > 0 && height > 0 && weights.len() == width * height,
+            "{} weights for a {width}x{height} grid",
+            weights.len()
+        );
+        let rows: Vec<Distribution1D> = weights
+            .chunks_exact(width)
+            .map(Distribution1D::new)
+            .collect();
+        let row_totals: Vec<f32> = rows.iter().map(|r| r.total() as f32).collect();
+        Distribution2D {
+            width,
+            height,
+            marginal: Distribution1D::new(&row_totals),
+            rows,
+        }
+    }
+
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// Sum of all (clamped) weights; 0 when the density fell back to uniform.
+    pub fn total(&self) -> f64 {
+        self.marginal.total()
+    }
+
+    /// A point of [0,1)² for `u` in [0,1)², with its density per unit area.
+    pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
+        let (y, pmf_y, ry) = self.marginal.sample(u.y);
+        let (x, pmf_x, rx) = self.rows[y].sample(u.x);
+        let p = Vec2::new(
+            ((x as f32 + rx) / self.width as f32).min(super::ONE_MINUS_EPSILON),
+            ((y as f32 + ry) / self.height as f32).min(super::ONE_MINUS_EPSILON),
+        );
+        (p, pmf_x * pmf_y * (self.width * self.height) as f32)
+    }
+
+    /// The cell holding `p` (clamped to the grid).
+    pub fn cell(&self, p: Vec2) -> (usize, usize) {
+        let x = ((p.x * self.width as f32).max(0.0) as usize).min(self.width - 1);
+        let y = ((p.y * self.height as f32).max(0.0) as usize).min(self.height - 1);
+        (x, y)
+    }
+
+    /// Density per unit area at `p`.
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        let (x, y) = self.cell(p);
+        self.marginal.pmf(y) * self.rows[y].pmf(x) * (self.width * self.height) as f32
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn two_d_density_follows_weights_and_integrates_to_one() {
+        let weights = [1.0, 0.0, 2.0, 0.0, 0.0, 0.0, 3.0, 1.0, 1.0];
+        let d = Distribution2D::new(&weights, 3, 3);
+        let total: f32 = weights.iter().sum();
+        let mut integral = 0.0;
+        for y in 0..3 {
+            for x in 0..3 {
+                let p = Vec2::new((x as f32 + 0.5) / 3.0, (y as f32 + 0.5) / 3.0);
+                let expected = 9.0 * weights[y * 3 + x] / total;
+                assert!((d.pdf(p) - expected).abs() < 1e-5, "{x},{y}");
+                integral += d.pdf(p) / 9.0;
+            }
+        }
+        assert!((integral - 1.0).abs() < 1e-5);
+        let n = 300;
+        let mut counts = [0usize; 9];
+        for i in 0..n {
+            for j in 0..n {
+                let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                let (p, pdf) = d.sample(u);
+                assert!(pdf > 0.0 && pdf == d.pdf(p));
+                let (x, y) = d.cell(p);
+                counts[y * 3 + x] += 1;
+            }
+        }
+        for (c, w) in counts.iter().zip(weights) {
+            let f = *c as f32 / (n * n) as f32;
+            assert!((f - w / total).abs() < 2e-3, "{f} vs {}", w / total);
+        }
+        let flat = Distribution2D::new(&[0.0; 4], 2, 2);
+        assert_eq!(flat.total(), 0.0);
+        assert_eq!(flat.pdf(Vec2::new(0.7, 0.2)), 1.0);
+    }
 
     #[test]
     fn sampling_frequencies_follow_weights() {

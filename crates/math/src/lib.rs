@@ -1,18 +1,20 @@
 //! Small math toolkit shared by every module: glam vectors (f32 for geometry, f64
 //! where precision matters), transforms, orthonormal frames, sample warps,
-//! discrete distributions and hashing.
+//! discrete and piecewise-constant distributions, the equal-area sphere mapping and
+//! hashing.
 
 #![forbid(unsafe_code)]
 
 pub mod color;
 pub mod distribution;
+pub mod equal_area;
 pub mod frame;
 pub mod hash;
 pub mod sampling;
 pub mod transform;
 
 pub use color::Rgb;
-pub use distribution::Distribution1D;
+pub use distribution::{Distribution1D, Distribution2D};
 pub use frame::Frame;
 pub use glam::{DMat4, DVec2, DVec3, Mat3, Mat4, Vec2, Vec3, Vec4};
 pub use transform::Transform;

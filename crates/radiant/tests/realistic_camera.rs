@@ -15,6 +15,7 @@ fn sky_image(lens: &str, aperture_mm: f32) -> radiant::image::Image {
     desc.shapes.clear();
     desc.lights.push(LightDesc::Infinite {
         radiance: Rgb::WHITE,
+        image: None,
         loc: desc.camera.loc.clone(),
     });
     desc.camera.kind = CameraKind::Realistic {

@@ -332,6 +332,7 @@ fn disk_light_sample_li_follows_pdf_li() {
 fn infinite_light_sample_li_follows_pdf_li() {
     let light = Light::Infinite {
         radiance: Rgb::splat(0.7),
+        map: None,
     };
     let ctx = LightSampleContext::at_point(Vec3::new(0.3, 2.0, -1.0));
     let scene = test_sphere();
@@ -768,6 +769,7 @@ fn lights_at_infinity_sample_le_follow_their_densities() {
     );
     let infinite = Light::Infinite {
         radiance: Rgb::splat(0.5),
+        map: None,
     };
     le(
         le_test("infinite_le_position", Domain::Disk, 32),
@@ -840,6 +842,7 @@ fn mis_weighted_direct_light_has_the_mean_of_each_strategy() {
     ];
     let lights = vec![LightDesc::Infinite {
         radiance: Rgb::splat(0.3),
+        image: None,
         loc: cornell_box().camera.loc,
     }];
     let world = World::build(&scene_of(shapes, lights))

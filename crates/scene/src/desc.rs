@@ -6,6 +6,7 @@
 //! have already been folded into `L` / `I`.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
@@ -299,8 +300,39 @@ pub enum LightDesc {
         radiance: Rgb,
         loc: FileLoc,
     },
-    /// Constant environment radiance from every direction.
-    Infinite { radiance: Rgb, loc: FileLoc },
+    /// Light from every direction: constant `radiance`, or with `image` the image's
+    /// radiance times `radiance` (the `scale`, with `illuminance` folded in).
+    Infinite {
+        radiance: Rgb,
+        image: Option<EnvironmentImage>,
+        loc: FileLoc,
+    },
+}
+
+/// The picture of an image-based infinite light: a square image in pbrt-v4's
+/// equal-area octahedral layout (pixel column `x`, row `y` from the top hold the
+/// directions of the square's points `((x + ½) / size, (y + ½) / size)`, see
+/// `radiant_math::equal_area`), in the light's frame (+z up), and the transform to
+/// render space (the CTM at `LightSource`).
+#[derive(Clone, PartialEq)]
+pub struct EnvironmentImage {
+    /// The file it was read from (for messages).
+    pub path: PathBuf,
+    /// Side in pixels.
+    pub size: usize,
+    /// Linear RGB, row-major, `size * size` of them, negative values clamped to 0.
+    pub pixels: Arc<Vec<Rgb>>,
+    pub render_from_light: Transform,
+}
+
+impl std::fmt::Debug for EnvironmentImage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EnvironmentImage")
+            .field("path", &self.path)
+            .field("size", &self.size)
+            .field("render_from_light", &self.render_from_light)
+            .finish_non_exhaustive()
+    }
 }
 
 /// The z range `(low, high)` of a sphere of `radius` cut at `z_min` and `z_max`, as

@@ -417,3 +417,71 @@ fn bad_values_are_errors_at_their_location() {
         assert!(e.starts_with(at), "{text:?}: expected {at}, got {e}");
     }
 }
+
+#[test]
+fn infinite_light_with_an_image() {
+    use radiant_math::equal_area::square_to_sphere;
+    let dir = std::env::temp_dir().join(format!("radiant-envparse-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // 4 x 4 pixels: each pixel's value is its index + 1 (row-major from the top).
+    let mut bytes = b"PF\n4 4\n-1.0\n".to_vec();
+    // PFM stores the bottom row first.
+    for y in (0..4).rev() {
+        for x in 0..4 {
+            let v = (y * 4 + x + 1) as f32;
+            for c in [v, 2.0 * v, 0.5 * v] {
+                bytes.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+    }
+    std::fs::write(dir.join("sky.pfm"), bytes).unwrap();
+    let s = parse_str(
+        "WorldBegin\nAttributeBegin\nRotate -90 1 0 0\n\
+         LightSource \"infinite\" \"string filename\" \"sky.pfm\" \"float scale\" 3 \"point3 portal\" [0 0 0 1 0 0 1 1 0 0 1 0]\nAttributeEnd\n\
+         LightSource \"infinite\" \"string filename\" \"sky.pfm\" \"float illuminance\" 7\n",
+        "t.pbrt",
+        &dir,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let LightDesc::Infinite {
+        radiance,
+        image: Some(image),
+        ..
+    } = &s.lights[0]
+    else {
+        panic!("{:?}", s.lights[0])
+    };
+    assert_eq!(*radiance, Rgb::splat(3.0));
+    assert_eq!(image.size, 4);
+    assert_eq!(image.pixels[6], Rgb::new(7.0, 14.0, 3.5));
+    // The CTM orients the image: the light's +z is world +y.
+    assert!((image.render_from_light.vector(Vec3::Z) - Vec3::Y).length() < 1e-6);
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.message.contains("\"portal\" ignored")),
+        "{:?}",
+        s.warnings
+    );
+    // illuminance: Σ over pixels above the horizon of Y cos θ · 4π / 16 = 7.
+    let LightDesc::Infinite {
+        radiance,
+        image: Some(image),
+        ..
+    } = &s.lights[1]
+    else {
+        panic!()
+    };
+    let mut e = 0.0;
+    for (k, p) in image.pixels.iter().enumerate() {
+        let w = square_to_sphere(Vec2::new(
+            ((k % 4) as f32 + 0.5) / 4.0,
+            ((k / 4) as f32 + 0.5) / 4.0,
+        ));
+        if w.z > 0.0 {
+            e += (*p * *radiance).luminance() * w.z * 4.0 * PI / 16.0;
+        }
+    }
+    assert!(close(e, 7.0), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}

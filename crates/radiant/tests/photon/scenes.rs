@@ -125,6 +125,7 @@ pub fn open_sky() -> SceneDesc {
         },
         LightDesc::Infinite {
             radiance: Rgb::splat(0.05),
+            image: None,
             loc,
         },
     ];

@@ -14,7 +14,7 @@ use super::face_mesh::{FaceMesh, Subdivision};
 use super::patch::PatchSet;
 use crate::settings::{DEFAULT_PATCH_COUNT, RadiositySettings, SolverKind};
 use radiant_scene::{
-    Geometry, LightDesc, MaterialDesc, SceneDesc, SceneError, ShapeDesc, Warning, sphere_z_range,
+    Geometry, MaterialDesc, SceneDesc, SceneError, ShapeDesc, Warning, sphere_z_range,
 };
 
 /// What every patch of one input face carries.
@@ -111,16 +111,6 @@ impl RadiosityScene {
                 loc,
                 message: "radiosity: specular and glossy materials (mirror, glass, metal, rough metal and glass) have no diffuse part; their patches absorb all light".into(),
             });
-        }
-        for light in &desc.lights {
-            if let LightDesc::Infinite { loc, .. } = light {
-                warnings.push(Warning {
-                    loc: loc.clone(),
-                    message:
-                        "radiosity: infinite (environment) lights are not supported and are ignored"
-                            .into(),
-                });
-            }
         }
 
         let total_area: f64 = shapes

@@ -18,6 +18,7 @@ use radiant_math::color::Rgb;
 use radiant_math::{Frame, sampling};
 use radiant_render::geometry::Ray;
 use radiant_render::geometry::SurfacePoint;
+use radiant_render::integrator::direct::environment;
 use radiant_render::integrator::specular::specular_bounce;
 use radiant_render::integrator::{PixelEstimator, PixelId};
 use radiant_render::light::LightSampleContext;
@@ -136,6 +137,8 @@ impl<'a> Shading<'a> {
         for _ in 0..=self.specular_depth {
             rays += 1;
             let Some(hit) = self.tracer.intersect(self.scene, &ray, f32::INFINITY) else {
+                // Lights at infinity seen directly or through specular surfaces.
+                l += beta * environment(self.world, ray.d);
                 break;
             };
             // Specular surfaces are two-sided (a ray inside glass meets the back of the

@@ -1,7 +1,7 @@
-//! Solving a meshed scene: the first shot of point, spot and distant lights, form
+//! Solving a meshed scene: the first shot of point, spot, distant and infinite lights, form
 //! factors by the chosen method, the chosen solver, and the power balance.
 //!
-//! Delta lights have no patches. Their direct irradiance `H0_j` (with shadow rays) is
+//! Lights that are not area lights (delta lights and environments) have no patches. Their direct irradiance `H0_j` (with shadow rays) is
 //! added as a source term: the solver sees `E'_j = E_j + rho_j H0_j`, the radiosity of
 //! the light's first reflection, which is exact for `B = E + rho (H0 + F B)`. The power
 //! they send is booked separately: what reaches patches is absorbed or reflected there,
@@ -173,53 +173,83 @@ pub enum SolveEvent<'a> {
     },
 }
 
-/// Direct irradiance of the point, spot and distant lights on every patch (3 x 3
-/// Gauss points per patch, a shadow ray each), and their total power.
+/// Light samples per Gauss point for lights at infinity that are not delta lights
+/// (environments): a 4 x 4 stratified grid, jittered by a generator seeded per patch.
+const ENVIRONMENT_STRATA: u32 = 4;
+
+/// Direct irradiance of the point, spot, distant and infinite lights on every patch
+/// (3 x 3 Gauss points per patch; a shadow ray each for delta lights, 16 importance
+/// samples of the environment, each with a shadow ray, for infinite ones), and their
+/// total power. An environment's power is its flux through the disk covering the scene
+/// (`Light::power`); what no patch receives escapes.
 pub fn delta_light_irradiance<V: Visibility>(
     set: &PatchSet,
     lights: &[Light],
     sphere: SceneSphere,
     vis: &V,
 ) -> (Vec<[f64; 3]>, [f64; 3]) {
-    let delta: Vec<&Light> = lights
+    let first_shot: Vec<&Light> = lights
         .iter()
         .filter(|l| {
             matches!(
                 l,
-                Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
+                Light::Point { .. }
+                    | Light::Spot { .. }
+                    | Light::Distant { .. }
+                    | Light::Infinite { .. }
             )
         })
         .collect();
     let mut power = [0.0; 3];
-    for l in &delta {
+    for l in &first_shot {
         let p = l.power(sphere).to_array();
         for b in 0..3 {
             power[b] += p[b] as f64;
         }
     }
-    if delta.is_empty() {
+    if first_shot.is_empty() {
         return (vec![[0.0; 3]; set.len()], power);
     }
     let rule = PatchRule::Tensor(Rule1D::gauss_legendre(3));
+    let strata = ENVIRONMENT_STRATA;
     let irradiance = (0..set.len())
         .into_par_iter()
         .map(|j| {
             let patch = &set.patches[j];
             let mut sum = [0.0; 3];
             let mut rng = Pcg32::new(0, 0);
+            let mut jitter = Pcg32::new(j as u64, 0x0e4f);
             rule.for_each_point(set.polygon(j).as_slice(), &mut rng, |x, w| {
-                for light in &delta {
-                    let ctx = LightSampleContext::on_surface(x.as_vec3(), patch.normal.as_vec3());
-                    let Some(s) = light.sample_li(&ctx, Vec2::ZERO, sphere) else {
-                        continue;
+                let ctx = LightSampleContext::on_surface(x.as_vec3(), patch.normal.as_vec3());
+                for light in &first_shot {
+                    let (count, scale) = if light.is_delta() {
+                        (1, 1.0)
+                    } else {
+                        (strata * strata, 1.0 / (strata * strata) as f64)
                     };
-                    let cos = patch.normal.dot(s.wi.as_dvec3());
-                    if cos <= 0.0 || !vis.visible(x, s.p_light.p.as_dvec3(), j, NO_PATCH) {
-                        continue;
-                    }
-                    let li = s.li.to_array();
-                    for b in 0..3 {
-                        sum[b] += w * cos * li[b] as f64;
+                    for k in 0..count {
+                        let u = if light.is_delta() {
+                            Vec2::ZERO
+                        } else {
+                            Vec2::new(
+                                ((k % strata) as f32 + jitter.uniform()) / strata as f32,
+                                ((k / strata) as f32 + jitter.uniform()) / strata as f32,
+                            )
+                            .min(Vec2::splat(radiant_math::ONE_MINUS_EPSILON))
+                        };
+                        let Some(s) = light.sample_li(&ctx, u, sphere) else {
+                            continue;
+                        };
+                        let cos = patch.normal.dot(s.wi.as_dvec3());
+                        if cos <= 0.0 || !vis.visible(x, s.p_light.p.as_dvec3(), j, NO_PATCH) {
+                            continue;
+                        }
+                        // Delta lights report pdf 1.
+                        let weight = w * cos * scale / s.pdf as f64;
+                        let li = s.li.to_array();
+                        for b in 0..3 {
+                            sum[b] += weight * li[b] as f64;
+                        }
                     }
                 }
             });

@@ -23,6 +23,9 @@ pub struct ShadingPoint<'a> {
     pub wo: Vec3,
     /// The same direction in render space.
     pub wo_world: Vec3,
+    /// The light sample will be weighted against BSDF sampling by MIS (see
+    /// `LightSampleContext::mis_with_bsdf`).
+    pub mis_with_bsdf: bool,
 }
 
 impl<'a> ShadingPoint<'a> {
@@ -35,6 +38,15 @@ impl<'a> ShadingPoint<'a> {
             frame,
             wo: frame.to_local(wo_world),
             wo_world,
+            mis_with_bsdf: false,
+        }
+    }
+
+    /// The same point, for a light sample that MIS combines with a BSDF sample.
+    pub fn with_mis(self) -> ShadingPoint<'a> {
+        ShadingPoint {
+            mis_with_bsdf: true,
+            ..self
         }
     }
 }
@@ -90,7 +102,10 @@ pub fn sample_direct(
         shadow_rays: 0,
     };
     let hit = at.hit;
-    let ctx = hit.light_sample_context();
+    let mut ctx = hit.light_sample_context();
+    if at.mis_with_bsdf {
+        ctx = ctx.with_mis();
+    }
     let Some(chosen) = world.light_sampler.sample(&ctx, u_choice) else {
         return out;
     };

@@ -102,7 +102,7 @@ pub fn radiance(
     let mut specular_bounce = true;
     let mut prev_pdf = 0.0f32;
     // The previous vertex as a receiver, for the light-sampling density of what a
-    // BSDF-sampled ray finds.
+    // BSDF-sampled ray finds (with MIS, as its light samples were drawn).
     let mut prev_ctx = LightSampleContext::at_point(ray.o);
     let mut rays = 0u32;
     let mut depth = 0u32;
@@ -155,7 +155,7 @@ pub fn radiance(
         let u_choice = sampler.get_1d();
         let u_light = sampler.get_2d();
         if !material.is_specular() {
-            let at = direct::ShadingPoint::new(&hit, material, wo_world);
+            let at = direct::ShadingPoint::new(&hit, material, wo_world).with_mis();
             let ds = direct::sample_direct(world, scene, &at, u_choice, u_light);
             rays += ds.shadow_rays;
             if let Some(ds) = ds.light {
@@ -190,7 +190,7 @@ pub fn radiance(
         }
         specular_bounce = bs.specular;
         prev_pdf = bs.pdf;
-        prev_ctx = hit.light_sample_context();
+        prev_ctx = hit.light_sample_context().with_mis();
         ray = hit.spawn_ray(wi);
 
         let u_rr = sampler.get_1d();

@@ -9,6 +9,7 @@
 //! leaving the light with the flux it carries (photon tracing).
 
 mod area;
+mod environment;
 mod infinite;
 mod point;
 mod sampler;
@@ -16,6 +17,7 @@ mod sampler;
 use glam::{Vec2, Vec3};
 
 pub use area::{AreaLight, LightShape};
+pub use environment::{EnvironmentMap, rotation_of};
 pub use sampler::{
     LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, LightSampler, SampledLight, UnknownLightSampler,
 };
@@ -37,6 +39,11 @@ pub struct LightSampleContext {
     pub p: Vec3,
     pub n: Vec3,
     pub ns: Vec3,
+    /// The caller weights light samples against BSDF samples by multiple importance
+    /// sampling, so a light may leave directions it would sample poorly to the BSDF
+    /// (zero density there; pbrt-v4's `allowIncompletePDF`). Only environment images
+    /// use it. `sample_li` and `pdf_li` must see the same value.
+    pub mis_with_bsdf: bool,
 }
 
 impl LightSampleContext {
@@ -46,12 +53,26 @@ impl LightSampleContext {
             p,
             n: Vec3::ZERO,
             ns: Vec3::ZERO,
+            mis_with_bsdf: false,
+        }
+    }
+
+    /// The same receiver, for light samples that MIS combines with BSDF samples.
+    pub fn with_mis(self) -> LightSampleContext {
+        LightSampleContext {
+            mis_with_bsdf: true,
+            ..self
         }
     }
 
     /// A receiver on a surface without a separate shading normal (radiosity patches).
     pub fn on_surface(p: Vec3, n: Vec3) -> LightSampleContext {
-        LightSampleContext { p, n, ns: n }
+        LightSampleContext {
+            p,
+            n,
+            ns: n,
+            mis_with_bsdf: false,
+        }
     }
 }
 
@@ -153,9 +174,11 @@ pub enum Light {
         direction: Vec3,
         radiance: Rgb,
     },
-    /// Constant radiance from every direction.
+    /// Light from every direction: constant `radiance` (sampled uniformly), or an
+    /// environment image (`map`, which holds its own scale; `radiance` is then unused).
     Infinite {
         radiance: Rgb,
+        map: Option<std::sync::Arc<EnvironmentMap>>,
     },
 }
 
@@ -179,7 +202,8 @@ impl Light {
                 ..
             } => *intensity * (2.0 * PI * (1.0 - 0.5 * (cos_falloff_start + cos_total_width))),
             Light::Distant { radiance, .. } => *radiance * (PI * scene.radius * scene.radius),
-            Light::Infinite { radiance } => {
+            Light::Infinite { map: Some(m), .. } => m.power(scene),
+            Light::Infinite { radiance, .. } => {
                 *radiance * (4.0 * PI * PI * scene.radius * scene.radius)
             }
         }
@@ -225,7 +249,8 @@ impl Light {
                 delta: true,
                 at_infinity: true,
             }),
-            Light::Infinite { radiance } => infinite::sample_li(ctx, *radiance, u, scene),
+            Light::Infinite { map: Some(m), .. } => m.sample_li(ctx, u, scene),
+            Light::Infinite { radiance, .. } => infinite::sample_li(ctx, *radiance, u, scene),
         }
     }
 
@@ -236,15 +261,17 @@ impl Light {
     pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3, hit: Option<&LightHit>) -> f32 {
         match self {
             Light::Area(a) => hit.map_or(0.0, |h| a.pdf_li(ctx, h)),
+            Light::Infinite { map: Some(m), .. } => m.pdf_li(ctx, wi),
             Light::Infinite { .. } => infinite::pdf_li(wi),
             _ => 0.0,
         }
     }
 
     /// Radiance from an infinite light along a ray that escapes in direction `d`.
-    pub fn environment(&self, _d: Vec3) -> Rgb {
+    pub fn environment(&self, d: Vec3) -> Rgb {
         match self {
-            Light::Infinite { radiance } => *radiance,
+            Light::Infinite { map: Some(m), .. } => m.radiance(d),
+            Light::Infinite { radiance, .. } => *radiance,
             _ => Rgb::BLACK,
         }
     }
@@ -276,7 +303,8 @@ impl Light {
                 direction,
                 radiance,
             } => Some(infinite::emit_parallel(*direction, *radiance, u_pos, scene)),
-            Light::Infinite { radiance } => {
+            Light::Infinite { map: Some(m), .. } => m.sample_le(u_pos, u_dir, scene),
+            Light::Infinite { radiance, .. } => {
                 Some(infinite::emit_infinite(*radiance, u_pos, u_dir, scene))
             }
         }

@@ -147,6 +147,7 @@ fn emitted_power_equals_light_power() {
         },
         Light::Infinite {
             radiance: Rgb::splat(0.5),
+            map: None,
         },
     ];
     let mut rng = Pcg32::new(8, 8);

@@ -1,6 +1,8 @@
 //! Building the world from a scene description: geometry to render space in flat
 //! arrays, one light per emitting primitive, the BVH over everything.
 
+use std::sync::Arc;
+
 use glam::{Mat3, Vec2, Vec3};
 
 use super::shapes::{BilinearPrim, Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr};
@@ -9,8 +11,8 @@ use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
 use crate::light::{
-    AreaLight, LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, Light, LightSampler, LightShape,
-    SceneSphere,
+    AreaLight, EnvironmentMap, LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, Light, LightSampler,
+    LightShape, SceneSphere, rotation_of,
 };
 use crate::material::Material;
 use radiant_math::Transform;
@@ -65,7 +67,9 @@ impl World {
         top.finish(&prototypes);
         let bounds = top.bounds();
 
-        lights.extend(desc.lights.iter().map(light_from_desc));
+        for l in &desc.lights {
+            lights.push(light_from_desc(l, &mut warnings));
+        }
         let light_sampler =
             light_sampler_from_desc(desc, &lights, SceneSphere::around(&bounds), &mut warnings)?;
         let world = World {
@@ -112,7 +116,7 @@ fn light_sampler_from_desc(
     Ok(sampler)
 }
 
-fn light_from_desc(l: &LightDesc) -> Light {
+fn light_from_desc(l: &LightDesc, warnings: &mut Vec<Warning>) -> Light {
     match l {
         LightDesc::Point {
             position,
@@ -144,9 +148,36 @@ fn light_from_desc(l: &LightDesc) -> Light {
             direction: direction.normalize(),
             radiance: *radiance,
         },
-        LightDesc::Infinite { radiance, .. } => Light::Infinite {
+        LightDesc::Infinite {
+            radiance,
+            image: None,
+            ..
+        } => Light::Infinite {
             radiance: *radiance,
+            map: None,
         },
+        LightDesc::Infinite {
+            radiance,
+            image: Some(image),
+            loc,
+        } => {
+            let (rotation, similar) = rotation_of(&image.render_from_light);
+            if !similar {
+                warnings.push(Warning {
+                    loc: loc.clone(),
+                    message: "LightSource \"infinite\": the transform is not a rotation and uniform scale; only its rotation orients the image".into(),
+                });
+            }
+            Light::Infinite {
+                radiance: *radiance,
+                map: Some(Arc::new(EnvironmentMap::new(
+                    image.size,
+                    image.pixels.clone(),
+                    *radiance,
+                    rotation,
+                ))),
+            }
+        }
     }
 }
 

@@ -60,6 +60,7 @@ impl SurfaceHit {
             p: self.p,
             n: self.ng,
             ns: self.ns,
+            mis_with_bsdf: false,
         }
     }
 

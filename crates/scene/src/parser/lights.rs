@@ -12,7 +12,8 @@
 //! - `"spot"`: `I`, `from` (0,0,0), `to` (0,0,1), `coneangle` 30°, `conedeltaangle` 5°,
 //!   `scale`, `power`.
 //! - `"distant"`: `L`, `from` (0,0,0), `to` (0,0,1), `scale`, `illuminance`.
-//! - `"infinite"`: `L` (constant only), `scale`, `illuminance`.
+//! - `"infinite"`: `L` (constant) or `filename` (a square equal-area octahedral image:
+//!   EXR, PFM or PNG), `scale`, `illuminance`; `portal` is read and ignored.
 //! - `AreaLightSource "diffuse"`: `L`, `scale`, `twosided` (false), `power`.
 
 use glam::Vec3;
@@ -20,7 +21,7 @@ use glam::Vec3;
 use super::Parser;
 use super::spectrum_param::SpectrumUse;
 use super::state::{AreaLightState, with_defaults};
-use crate::desc::LightDesc;
+use crate::desc::{EnvironmentImage, LightDesc};
 use crate::error::{FileLoc, SceneError};
 use crate::params::{ParamSet, ParamValue};
 use radiant_math::PI;
@@ -158,18 +159,7 @@ impl Parser {
                         loc: loc.clone(),
                     }
                 } else {
-                    for unsupported in ["filename", "portal"] {
-                        if let Some(p) = ps.lookup(unsupported) {
-                            let at = p.loc.clone();
-                            self.warn(&at, format!("{owner}: \"{unsupported}\" is not supported; using constant radiance L"));
-                        }
-                    }
-                    LightDesc::Infinite {
-                        // Constant L over the upper hemisphere gives E = π L on an
-                        // upward-facing surface.
-                        radiance: e.map_or(l, |e| l * photometric_factor(l, e / PI)),
-                        loc: loc.clone(),
-                    }
+                    self.infinite_light(&ps, l, e, &owner, loc)?
                 }
             }
             "goniometric" | "projection" => {
@@ -182,6 +172,115 @@ impl Parser {
         self.report_unused(&ps, &owner);
         self.lights.push(light);
         Ok(())
+    }
+
+    /// `LightSource "infinite"`: constant `l`, or the image of `filename` times the
+    /// scale in `l`; `e` the `illuminance` asked for.
+    fn infinite_light(
+        &mut self,
+        ps: &ParamSet,
+        l: Rgb,
+        e: Option<f32>,
+        owner: &str,
+        loc: &FileLoc,
+    ) -> Result<LightDesc, SceneError> {
+        if let Some(p) = ps.lookup("portal") {
+            let at = p.loc.clone();
+            self.warn(
+                &at,
+                format!("{owner}: \"portal\" ignored (the whole environment is sampled)"),
+            );
+        }
+        let Some((names, at)) = ps.strings("filename")? else {
+            return Ok(LightDesc::Infinite {
+                // Constant L over the upper hemisphere gives E = π L on an
+                // upward-facing surface.
+                radiance: e.map_or(l, |e| l * photometric_factor(l, e / PI)),
+                image: None,
+                loc: loc.clone(),
+            });
+        };
+        let [written] = names else {
+            return Err(SceneError::at(at, "\"filename\" needs one value"));
+        };
+        let at = at.clone();
+        if let Some(p) = ps.lookup("L") {
+            return Err(SceneError::at(
+                &p.loc,
+                format!("{owner}: give either \"L\" or \"filename\", not both"),
+            ));
+        }
+        let path = self.resolve_path(written);
+        let image = radiant_image::read_image(&path)
+            .map_err(|err| SceneError::at(&at, format!("cannot read environment image: {err}")))?;
+        if image.width != image.height {
+            return Err(SceneError::at(
+                &at,
+                format!(
+                    "{}: environment image is {}x{}; an infinite light needs a square image in \
+                     the equal-area octahedral layout (convert a latitude-longitude map with \
+                     pbrt-v4's `imgtool makeequiarea`)",
+                    path.display(),
+                    image.width,
+                    image.height
+                ),
+            ));
+        }
+        if let Some(k) = image.pixels.iter().position(|p| !p.is_finite()) {
+            return Err(SceneError::at(
+                &at,
+                format!(
+                    "{}: pixel ({}, {}) is not finite",
+                    path.display(),
+                    k % image.width,
+                    k / image.width
+                ),
+            ));
+        }
+        let size = image.width;
+        let pixels: Vec<Rgb> = image.pixels.iter().map(|p| p.clamp_min(0.0)).collect();
+        // The scale in `l` is applied as RGB; `illuminance` rescales it so that a surface
+        // facing +z in the light's frame receives that illuminance from the image:
+        // E = Σ_{z > 0} Y_i cos θ_i ΔΩ, ΔΩ = 4π / N for the equal-area pixels.
+        let radiance = match e {
+            None => l,
+            Some(target) => {
+                let d_omega =
+                    radiant_math::equal_area::SOLID_ANGLE_PER_AREA as f64 / (size * size) as f64;
+                let mut k_e = 0.0f64;
+                for (k, p) in pixels.iter().enumerate() {
+                    let st = glam::Vec2::new(
+                        ((k % size) as f32 + 0.5) / size as f32,
+                        ((k / size) as f32 + 0.5) / size as f32,
+                    );
+                    let w = radiant_math::equal_area::square_to_sphere(st);
+                    if w.z > 0.0 {
+                        k_e += (p.luminance() * w.z) as f64 * d_omega;
+                    }
+                }
+                if k_e > 0.0 {
+                    l * (target as f64 / k_e) as f32
+                } else {
+                    self.warn(
+                        &at,
+                        format!(
+                            "{owner}: the image is black above the horizon; \"illuminance\" ignored"
+                        ),
+                    );
+                    l
+                }
+            }
+        };
+        Ok(LightDesc::Infinite {
+            radiance,
+            image: Some(EnvironmentImage {
+                path,
+                size,
+                pixels: std::sync::Arc::new(pixels),
+                render_from_light: self.gs.ctm,
+            }),
+            loc: loc.clone(),
+        })
     }
 
     pub(super) fn area_light_source(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
