@@ -6,7 +6,6 @@
 //! have already been folded into `L` / `I`.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
@@ -301,7 +300,7 @@ pub enum LightDesc {
         loc: FileLoc,
     },
     /// Light from every direction: constant `radiance`, or with `image` the image's
-    /// radiance times `radiance` (the `scale`, with `illuminance` folded in).
+    /// radiance times `radiance` (the `scale`).
     Infinite {
         radiance: Rgb,
         image: Option<EnvironmentImage>,
@@ -309,30 +308,20 @@ pub enum LightDesc {
     },
 }
 
-/// The picture of an image-based infinite light: a square image in pbrt-v4's
-/// equal-area octahedral layout (pixel column `x`, row `y` from the top hold the
-/// directions of the square's points `((x + ½) / size, (y + ½) / size)`, see
-/// `radiant_math::equal_area`), in the light's frame (+z up), and the transform to
-/// render space (the CTM at `LightSource`).
-#[derive(Clone, PartialEq)]
+/// The picture of an image-based infinite light, as the scene names it: a square image
+/// in pbrt-v4's equal-area octahedral layout, in the light's frame (+z up), with the
+/// transform to render space (the CTM at `LightSource`). The image is read when the
+/// world is built, not by the parser.
+#[derive(Clone, Debug, PartialEq)]
 pub struct EnvironmentImage {
-    /// The file it was read from (for messages).
+    /// The file, resolved against the scene's folder.
     pub path: PathBuf,
-    /// Side in pixels.
-    pub size: usize,
-    /// Linear RGB, row-major, `size * size` of them, negative values clamped to 0.
-    pub pixels: Arc<Vec<Rgb>>,
+    /// Where the scene names the file (for errors about it).
+    pub at: FileLoc,
+    /// `illuminance`: the scale is adjusted so that a surface facing the light's +z
+    /// receives this illuminance from the image.
+    pub illuminance: Option<f32>,
     pub render_from_light: Transform,
-}
-
-impl std::fmt::Debug for EnvironmentImage {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("EnvironmentImage")
-            .field("path", &self.path)
-            .field("size", &self.size)
-            .field("render_from_light", &self.render_from_light)
-            .finish_non_exhaustive()
-    }
 }
 
 /// The z range `(low, high)` of a sphere of `radius` cut at `z_min` and `z_max`, as

@@ -125,20 +125,6 @@ const CASES: &[(&str, &str, u32, u32, &[&str])] = &[
         &["64.5 is not a 32-bit integer"],
     ),
     (
-        "missing_envmap.pbrt",
-        "missing_envmap.pbrt",
-        3,
-        26,
-        &["cannot read environment image", "no-such-sky.exr"],
-    ),
-    (
-        "nonsquare_envmap.pbrt",
-        "nonsquare_envmap.pbrt",
-        3,
-        5,
-        &["nonsquare-sky.pfm", "4x2", "square", "imgtool makeequiarea"],
-    ),
-    (
         "envmap_with_l.pbrt",
         "envmap_with_l.pbrt",
         2,

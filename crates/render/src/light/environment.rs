@@ -83,6 +83,34 @@ pub fn rotation_of(xf: &Transform) -> (Mat3, bool) {
     (Mat3::from_cols(x, y, z), similar)
 }
 
+/// An environment image as read: `size * size` linear RGB values, row 0 at v = 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnvironmentPicture {
+    pub size: usize,
+    pub pixels: Vec<Rgb>,
+}
+
+impl EnvironmentPicture {
+    /// Illuminance on a surface facing the image's +z, at scale 1:
+    /// E = Σ_{z > 0} Y_i cos θ_i ΔΩ, with ΔΩ = 4π / N for the equal-area pixels.
+    pub fn upper_illuminance(&self) -> f64 {
+        let size = self.size;
+        let d_omega = SOLID_ANGLE_PER_AREA as f64 / (size * size) as f64;
+        let mut e = 0.0f64;
+        for (k, p) in self.pixels.iter().enumerate() {
+            let st = Vec2::new(
+                ((k % size) as f32 + 0.5) / size as f32,
+                ((k / size) as f32 + 0.5) / size as f32,
+            );
+            let w = square_to_sphere(st);
+            if w.z > 0.0 {
+                e += (p.luminance() * w.z) as f64 * d_omega;
+            }
+        }
+        e
+    }
+}
+
 impl EnvironmentMap {
     /// `pixels`: `size * size` linear RGB values, row 0 at v = 0; each is multiplied
     /// by `scale`. `render_from_light` should be a rotation (see [`rotation_of`]).

@@ -11,13 +11,13 @@ use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
 use crate::light::{
-    AreaLight, EnvironmentMap, LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, Light, LightSampler,
-    LightShape, SceneSphere, rotation_of,
+    AreaLight, EnvironmentMap, EnvironmentPicture, LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, Light,
+    LightSampler, LightShape, SceneSphere, rotation_of,
 };
 use crate::material::Material;
 use radiant_math::Transform;
 use radiant_scene::{
-    AreaLightDesc, Geometry, LightDesc, SceneDesc, SceneError, ShapeDesc, Warning,
+    AreaLightDesc, EnvironmentImage, Geometry, LightDesc, SceneDesc, SceneError, ShapeDesc, Warning,
 };
 
 /// Errors building the world are scene errors: they name the shape's location.
@@ -68,7 +68,7 @@ impl World {
         let bounds = top.bounds();
 
         for l in &desc.lights {
-            lights.push(light_from_desc(l, &mut warnings));
+            lights.push(light_from_desc(l, &mut warnings)?);
         }
         let light_sampler =
             light_sampler_from_desc(desc, &lights, SceneSphere::around(&bounds), &mut warnings)?;
@@ -116,8 +116,8 @@ fn light_sampler_from_desc(
     Ok(sampler)
 }
 
-fn light_from_desc(l: &LightDesc, warnings: &mut Vec<Warning>) -> Light {
-    match l {
+fn light_from_desc(l: &LightDesc, warnings: &mut Vec<Warning>) -> Result<Light, BuildError> {
+    Ok(match l {
         LightDesc::Point {
             position,
             intensity,
@@ -168,17 +168,69 @@ fn light_from_desc(l: &LightDesc, warnings: &mut Vec<Warning>) -> Light {
                     message: "LightSource \"infinite\": the transform is not a rotation and uniform scale; only its rotation orients the image".into(),
                 });
             }
+            let picture = read_environment_image(image)?;
+            let scale = match image.illuminance {
+                None => *radiance,
+                Some(target) => match picture.upper_illuminance() {
+                    e if e > 0.0 => *radiance * (target as f64 / e) as f32,
+                    _ => {
+                        warnings.push(Warning {
+                            loc: image.at.clone(),
+                            message: "LightSource \"infinite\": the image is black above the horizon; \"illuminance\" ignored".into(),
+                        });
+                        *radiance
+                    }
+                },
+            };
             Light::Infinite {
-                radiance: *radiance,
+                radiance: scale,
                 map: Some(Arc::new(EnvironmentMap::new(
-                    image.size,
-                    image.pixels.clone(),
-                    *radiance,
+                    picture.size,
+                    Arc::new(picture.pixels),
+                    scale,
                     rotation,
                 ))),
             }
         }
+    })
+}
+
+/// Reads the image of an infinite light: square (pbrt-v4's equal-area octahedral
+/// layout), finite; negative values are clamped to 0. Errors are located at the
+/// `filename` parameter.
+fn read_environment_image(image: &EnvironmentImage) -> Result<EnvironmentPicture, BuildError> {
+    let at = &image.at;
+    let path = &image.path;
+    let read = radiant_image::read_image(path)
+        .map_err(|err| SceneError::at(at, format!("cannot read environment image: {err}")))?;
+    if read.width != read.height {
+        return Err(SceneError::at(
+            at,
+            format!(
+                "{}: environment image is {}x{}; an infinite light needs a square image in \
+                 the equal-area octahedral layout (convert a latitude-longitude map with \
+                 pbrt-v4's `imgtool makeequiarea`)",
+                path.display(),
+                read.width,
+                read.height
+            ),
+        ));
     }
+    if let Some(k) = read.pixels.iter().position(|p| !p.is_finite()) {
+        return Err(SceneError::at(
+            at,
+            format!(
+                "{}: pixel ({}, {}) is not finite",
+                path.display(),
+                k % read.width,
+                k / read.width
+            ),
+        ));
+    }
+    Ok(EnvironmentPicture {
+        size: read.width,
+        pixels: read.pixels.iter().map(|p| p.clamp_min(0.0)).collect(),
+    })
 }
 
 fn is_similarity(xf: &Transform) -> bool {

@@ -210,73 +210,12 @@ impl Parser {
                 format!("{owner}: give either \"L\" or \"filename\", not both"),
             ));
         }
-        let path = self.resolve_path(written);
-        let image = radiant_image::read_image(&path)
-            .map_err(|err| SceneError::at(&at, format!("cannot read environment image: {err}")))?;
-        if image.width != image.height {
-            return Err(SceneError::at(
-                &at,
-                format!(
-                    "{}: environment image is {}x{}; an infinite light needs a square image in \
-                     the equal-area octahedral layout (convert a latitude-longitude map with \
-                     pbrt-v4's `imgtool makeequiarea`)",
-                    path.display(),
-                    image.width,
-                    image.height
-                ),
-            ));
-        }
-        if let Some(k) = image.pixels.iter().position(|p| !p.is_finite()) {
-            return Err(SceneError::at(
-                &at,
-                format!(
-                    "{}: pixel ({}, {}) is not finite",
-                    path.display(),
-                    k % image.width,
-                    k / image.width
-                ),
-            ));
-        }
-        let size = image.width;
-        let pixels: Vec<Rgb> = image.pixels.iter().map(|p| p.clamp_min(0.0)).collect();
-        // The scale in `l` is applied as RGB; `illuminance` rescales it so that a surface
-        // facing +z in the light's frame receives that illuminance from the image:
-        // E = Σ_{z > 0} Y_i cos θ_i ΔΩ, ΔΩ = 4π / N for the equal-area pixels.
-        let radiance = match e {
-            None => l,
-            Some(target) => {
-                let d_omega =
-                    radiant_math::equal_area::SOLID_ANGLE_PER_AREA as f64 / (size * size) as f64;
-                let mut k_e = 0.0f64;
-                for (k, p) in pixels.iter().enumerate() {
-                    let st = glam::Vec2::new(
-                        ((k % size) as f32 + 0.5) / size as f32,
-                        ((k / size) as f32 + 0.5) / size as f32,
-                    );
-                    let w = radiant_math::equal_area::square_to_sphere(st);
-                    if w.z > 0.0 {
-                        k_e += (p.luminance() * w.z) as f64 * d_omega;
-                    }
-                }
-                if k_e > 0.0 {
-                    l * (target as f64 / k_e) as f32
-                } else {
-                    self.warn(
-                        &at,
-                        format!(
-                            "{owner}: the image is black above the horizon; \"illuminance\" ignored"
-                        ),
-                    );
-                    l
-                }
-            }
-        };
         Ok(LightDesc::Infinite {
-            radiance,
+            radiance: l,
             image: Some(EnvironmentImage {
-                path,
-                size,
-                pixels: std::sync::Arc::new(pixels),
+                path: self.resolve_path(written),
+                at,
+                illuminance: e,
                 render_from_light: self.gs.ctm,
             }),
             loc: loc.clone(),
