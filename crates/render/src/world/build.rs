@@ -4,7 +4,7 @@
 use glam::{Mat3, Vec2, Vec3};
 
 use super::shapes::{BilinearPrim, Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr};
-use super::{NO_LIGHT, World};
+use super::{MAX_MIX_DEPTH, MaterialEntry, NO_LIGHT, World};
 use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
@@ -15,7 +15,8 @@ use crate::light::{
 use crate::material::Material;
 use radiant_math::Transform;
 use radiant_scene::{
-    AreaLightDesc, Geometry, LightDesc, SceneDesc, SceneError, ShapeDesc, Warning,
+    AreaLightDesc, FileLoc, Geometry, LightDesc, MaterialDesc, SceneDesc, SceneError, ShapeDesc,
+    Warning,
 };
 
 /// Errors building the world are scene errors: they name the shape's location.
@@ -26,7 +27,7 @@ impl World {
     /// approximately (they are never silent).
     pub fn build(desc: &SceneDesc) -> Result<(World, Vec<Warning>), BuildError> {
         let mut warnings = Vec::new();
-        let materials: Vec<Material> = desc.materials.iter().map(Material::from_desc).collect();
+        let materials = material_table(&desc.materials)?;
         let mut lights = Vec::new();
 
         let mut prototypes = Vec::with_capacity(desc.objects.len());
@@ -160,11 +161,70 @@ fn is_similarity(xf: &Transform) -> bool {
         && m.y_axis.dot(m.z_axis).abs() < tol * a
 }
 
+/// The world's material table, entry for entry the description's: BSDFs, and mixes
+/// that refer to other entries (checked to be in range and free of cycles).
+fn material_table(descs: &[MaterialDesc]) -> Result<Vec<MaterialEntry>, BuildError> {
+    let table: Vec<MaterialEntry> = descs
+        .iter()
+        .map(|d| match d {
+            MaterialDesc::Mix { materials, amount } => MaterialEntry::Mix {
+                materials: *materials,
+                amount: *amount,
+            },
+            d => MaterialEntry::Bsdf(Material::from_desc(d)),
+        })
+        .collect();
+    let refuse = |msg: String| SceneError::at(&FileLoc::builtin("materials"), msg);
+    // Nesting depth of each entry, memoised; past the bound means a cycle (or nesting
+    // far beyond any real scene), and the recursion never goes deeper than the bound.
+    fn depth(table: &[MaterialEntry], memo: &mut [Option<usize>], i: u32, level: usize) -> usize {
+        if level > MAX_MIX_DEPTH {
+            return level;
+        }
+        if let Some(d) = memo[i as usize] {
+            return d;
+        }
+        let d = match table[i as usize] {
+            MaterialEntry::Bsdf(_) => 0,
+            MaterialEntry::Mix { materials, .. } => {
+                1 + materials
+                    .iter()
+                    .map(|&m| depth(table, memo, m, level + 1))
+                    .max()
+                    .unwrap_or(0)
+            }
+        };
+        if d <= MAX_MIX_DEPTH {
+            memo[i as usize] = Some(d);
+        }
+        d
+    }
+    for (i, entry) in table.iter().enumerate() {
+        let MaterialEntry::Mix { materials, .. } = entry else {
+            continue;
+        };
+        if let Some(&bad) = materials.iter().find(|&&m| m as usize >= table.len()) {
+            return Err(refuse(format!(
+                "mix material {i} refers to material {bad}, out of range"
+            )));
+        }
+    }
+    let mut memo = vec![None; table.len()];
+    for i in 0..table.len() {
+        if depth(&table, &mut memo, i as u32, 0) > MAX_MIX_DEPTH {
+            return Err(refuse(format!(
+                "mix material {i}: mixes nest more than {MAX_MIX_DEPTH} deep or form a cycle"
+            )));
+        }
+    }
+    Ok(table)
+}
+
 /// Adds one shape's primitives; area lights go to `lights` (None inside prototypes).
 fn add_shape(
     set: &mut ShapeSet,
     shape: &ShapeDesc,
-    materials: &[Material],
+    materials: &[MaterialEntry],
     lights: Option<&mut Vec<Light>>,
     warnings: &mut Vec<Warning>,
 ) -> Result<(), BuildError> {
@@ -180,7 +240,9 @@ fn add_shape(
         None => None,
     };
     // An interface without emission is no surface at all.
-    if materials[material as usize] == Material::Interface && emission.is_none() {
+    if materials[material as usize] == MaterialEntry::Bsdf(Material::Interface)
+        && emission.is_none()
+    {
         return Ok(());
     }
     let xf = shape.render_from_object;
@@ -246,7 +308,10 @@ fn add_shape(
                         .into(),
                 });
             }
-            add_mesh(set, shape, positions, tris, normals, uvs, emission)
+            add_mesh(set, shape, positions, tris, normals, uvs, emission);
+            if let Some(mesh) = set.meshes.last_mut() {
+                mesh.bilinear_halves = true;
+            }
         }
         Geometry::Sphere {
             radius,
@@ -407,5 +472,6 @@ fn add_mesh(
         indices,
         normals: n,
         uvs: uvs.clone(),
+        bilinear_halves: false,
     });
 }

@@ -18,8 +18,8 @@ use crate::light::SceneSphere;
 use crate::material::TransportMode;
 use crate::sampler::PixelSample;
 use crate::world::World;
+use radiant_math::INV_PI;
 use radiant_math::color::Rgb;
-use radiant_math::{Frame, INV_PI};
 use radiant_scene::SamplerKind;
 
 /// Per-thread buffers for lookups, so that camera paths do not allocate.
@@ -83,14 +83,14 @@ pub fn radiance(
         travelled += hit.t * ray.d.length();
         let wo_world = -ray.d.normalize();
         let emitted = surface_emission(world, &hit, wo_world);
-        let material = world.materials[hit.material as usize];
+        let material = world.material_at(&hit, wo_world);
+        let frame = World::shading_frame(&hit, &material);
         if material.passes_photon_paths() {
             // The camera sees emitters directly or through specular chains only.
             l += beta * emitted;
             if depth == settings.max_depth {
                 break;
             }
-            let frame = Frame::from_normal(hit.ns);
             let wo = frame.to_local(wo_world);
             let Some(wi) = specular_bounce(&material, &frame, wo, sampler, &mut beta) else {
                 break;
@@ -102,7 +102,6 @@ pub fn radiance(
             p: hit.p,
             n: facing(hit.ng, wo_world),
         };
-        let frame = Frame::from_normal(hit.ns);
         let wo = frame.to_local(wo_world);
         let bsdf = |wi: Vec3| material.eval(wo, frame.to_local(wi));
         let maps = ctx.maps;
@@ -202,9 +201,9 @@ fn final_gather(
             let Some(y) = world.intersect(&ray, f32::INFINITY) else {
                 break;
             };
-            let mat_y = world.materials[y.material as usize];
             let wo_y_world = -ray.d.normalize();
-            let frame_y = Frame::from_normal(y.ns);
+            let mat_y = world.material_at(&y, wo_y_world);
+            let frame_y = World::shading_frame(&y, &mat_y);
             let wo_y = frame_y.to_local(wo_y_world);
             if mat_y.passes_photon_paths() {
                 let Some(wi) = specular_bounce(&mat_y, &frame_y, wo_y, &mut s, &mut beta) else {

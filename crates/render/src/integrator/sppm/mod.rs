@@ -34,8 +34,8 @@ use crate::context::RenderContext;
 use crate::integrator::{Integrator, RenderControl, RenderOutput, Stats};
 use hashgrid::HashGrid;
 use radiant_image::{Film, FilmPixel, NonFinite};
+use radiant_math::PI;
 use radiant_math::color::Rgb;
-use radiant_math::{Frame, PI};
 use visible::{CameraSample, camera_sample};
 
 const SPPM_PASS: u64 = 0x5bb3;
@@ -218,8 +218,7 @@ fn render(
                     if l.wi.dot(vp.n) <= 0.0 {
                         continue;
                     }
-                    let material = &world.materials[vp.material as usize];
-                    let f = material.eval(vp.wo, Frame::from_normal(vp.ns).to_local(l.wi));
+                    let f = vp.material.eval(vp.wo, vp.frame.to_local(l.wi));
                     if !f.is_black() {
                         out.push((j, l.power * f));
                     }
