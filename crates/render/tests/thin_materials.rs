@@ -100,8 +100,14 @@ fn diffuse_transmission_is_reciprocal() {
     let m = diffuse_transmission(Rgb::new(0.6, 0.3, 0.1), Rgb::new(0.2, 0.25, 0.7));
     let mut rng = Pcg32::new(7, 1);
     for _ in 0..10_000 {
-        let a = direction(2.0 * rng.uniform() - 1.0, 6.28 * rng.uniform());
-        let b = direction(2.0 * rng.uniform() - 1.0, 6.28 * rng.uniform());
+        let a = direction(
+            2.0 * rng.uniform() - 1.0,
+            std::f32::consts::TAU * rng.uniform(),
+        );
+        let b = direction(
+            2.0 * rng.uniform() - 1.0,
+            std::f32::consts::TAU * rng.uniform(),
+        );
         assert_eq!(m.eval(a, b), m.eval(b, a), "{a} {b}");
         let expected = if a.z * b.z > 0.0 { 0.6 } else { 0.2 };
         assert!((m.eval(a, b).r - expected / std::f32::consts::PI).abs() < 1e-6);
@@ -326,4 +332,51 @@ fn anisotropic_roughness_follows_dpdu() {
     let rotated =
         "AttributeBegin\nRotate 90 1 0 0\nShape \"sphere\" \"float radius\" 1\nAttributeEnd";
     assert_stretched_along(rotated, side, Vec3::Z, Vec3::Y);
+}
+
+/// White furnace: under a uniform environment of radiance 1, objects that absorb
+/// nothing — diffuse transmission with reflectance + transmittance = 1, a thin
+/// dielectric, and a mix of the two — are invisible: the path tracer's mean radiance
+/// towards them is 1 within its measured noise.
+#[test]
+fn lossless_thin_materials_vanish_in_a_white_furnace() {
+    use radiant_render::integrator::{PathSettings, path};
+    use radiant_render::sampler::PixelSample;
+    let w = world(
+        "WorldBegin\nLightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n\
+         MakeNamedMaterial \"dt\" \"string type\" \"diffusetransmission\" \
+         \"rgb reflectance\" [ 0.3 0.3 0.3 ] \"rgb transmittance\" [ 0.7 0.7 0.7 ]\n\
+         MakeNamedMaterial \"thin\" \"string type\" \"thindielectric\"\n\
+         AttributeBegin\nTranslate -2.5 0 0\nNamedMaterial \"dt\"\nShape \"sphere\"\nAttributeEnd\n\
+         AttributeBegin\nNamedMaterial \"thin\"\nShape \"sphere\"\nAttributeEnd\n\
+         AttributeBegin\nTranslate 2.5 0 0\n\
+         Material \"mix\" \"string materials\" [ \"dt\" \"thin\" ] \"float amount\" 0.4\n\
+         Shape \"sphere\"\nAttributeEnd\n",
+    );
+    let settings = PathSettings {
+        max_depth: 1000,
+        rr_depth: 5,
+    };
+    for (k, x) in [-2.5f32, 0.0, 2.5].into_iter().enumerate() {
+        let n = 20_000u32;
+        let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+        for i in 0..n {
+            let mut s =
+                PixelSample::for_stream(radiant_scene::SamplerKind::Independent, 3, k as u64, i);
+            let u = s.get_2d();
+            // Rays from above through the sphere's disk, so that every one hits it.
+            let r = 0.95 * u.x.sqrt();
+            let phi = std::f32::consts::TAU * u.y;
+            let o = Vec3::new(x + r * phi.cos(), r * phi.sin(), 5.0);
+            let (l, _) = path::radiance(&w, &settings, Ray::new(o, -Vec3::Z), &mut s);
+            sum += l.g as f64;
+            sum2 += (l.g as f64).powi(2);
+        }
+        let mean = sum / n as f64;
+        let sd = ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
+        assert!(
+            (mean - 1.0).abs() < 5.0 * sd + 1e-4,
+            "sphere {k}: mean {mean} ± {sd}"
+        );
+    }
 }

@@ -170,6 +170,12 @@ impl Material {
         self.is_specular() || matches!(self, Material::RoughDielectric { .. })
     }
 
+    /// True where a non-delta BSDF transmits: density estimates there take photons
+    /// from both sides of the surface.
+    pub fn transmits_diffusely(&self) -> bool {
+        matches!(self, Material::DiffuseTransmission { .. })
+    }
+
     /// True for the Lambertian material only: what radiosity can mesh and solve.
     pub fn is_diffuse(&self) -> bool {
         matches!(self, Material::Diffuse { .. })

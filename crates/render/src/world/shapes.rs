@@ -475,7 +475,9 @@ impl ShapeSet {
         let tuv = match &mesh.uvs {
             Some(uvs) => vi.map(|v| uvs[v]),
             // The two halves of a planar bilinear patch: (p00, p10, p11), (p00, p11, p01).
-            None if mesh.bilinear_halves && attr.index % 2 == 0 => [Vec2::ZERO, Vec2::X, Vec2::ONE],
+            None if mesh.bilinear_halves && attr.index.is_multiple_of(2) => {
+                [Vec2::ZERO, Vec2::X, Vec2::ONE]
+            }
             None if mesh.bilinear_halves => [Vec2::ZERO, Vec2::ONE, Vec2::Y],
             // pbrt's default parameterisation: (0,0), (1,0), (1,1).
             None => [Vec2::ZERO, Vec2::X, Vec2::ONE],

@@ -101,6 +101,7 @@ pub fn radiance(
         let at = EstimatePoint {
             p: hit.p,
             n: facing(hit.ng, wo_world),
+            two_sided: material.transmits_diffusely(),
         };
         let wo = frame.to_local(wo_world);
         let bsdf = |wi: Vec3| material.eval(wo, frame.to_local(wi));
@@ -220,6 +221,7 @@ fn final_gather(
             let at = EstimatePoint {
                 p: y.p,
                 n: facing(y.ng, wo_y_world),
+                two_sided: false,
             };
             let irradiance = gathered_irradiance(maps, &at, scratch);
             sum += beta * (direct.unweighted() + irradiance * mat_y.diffuse_albedo() * INV_PI);

@@ -215,7 +215,8 @@ fn render(
                     }
                     let j = e.index;
                     let vp = &samples[j as usize].vp;
-                    if l.wi.dot(vp.n) <= 0.0 {
+                    // Photons from behind count only where the BSDF transmits diffusely.
+                    if l.wi.dot(vp.n) <= 0.0 && !vp.material.transmits_diffusely() {
                         continue;
                     }
                     let f = vp.material.eval(vp.wo, vp.frame.to_local(l.wi));
