@@ -15,7 +15,7 @@ use crate::integrator::direct::{
 };
 use crate::integrator::specular::specular_bounce;
 use crate::light::SceneSphere;
-use crate::material::TransportMode;
+use crate::material::{Material, TransportMode};
 use crate::sampler::PixelSample;
 use crate::world::World;
 use radiant_math::INV_PI;
@@ -221,10 +221,23 @@ fn final_gather(
             let at = EstimatePoint {
                 p: y.p,
                 n: facing(y.ng, wo_y_world),
-                two_sided: false,
+                two_sided: mat_y.transmits_diffusely(),
             };
-            let irradiance = gathered_irradiance(maps, &at, scratch);
-            sum += beta * (direct.unweighted() + irradiance * mat_y.diffuse_albedo() * INV_PI);
+            let indirect = if let Material::Diffuse { albedo } = mat_y {
+                gathered_irradiance(maps, &at, scratch) * albedo * INV_PI
+            } else {
+                // A glossy (or transmitting) surface reflects the photons' light by its
+                // BSDF, not by an albedo: the two maps' radiance estimates with the BSDF
+                // evaluated per photon (Jensen 2001, §7.5). An irradiance times the
+                // diffuse albedo, zero for a rough metal, would drop all of it.
+                let bsdf = |wi: Vec3| mat_y.eval(wo_y, frame_y.to_local(wi));
+                let estimate = |map, neighbours: &mut _| {
+                    radiance_estimate(map, &at, maps.max_r2, settings.kernel, 0, neighbours, bsdf)
+                };
+                estimate(&maps.global, &mut scratch.global)
+                    + estimate(&maps.caustic, &mut scratch.caustic)
+            };
+            sum += beta * (direct.unweighted() + indirect);
             break;
         }
     }
