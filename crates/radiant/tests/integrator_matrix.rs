@@ -447,6 +447,7 @@ fn precomputed_irradiance_error(session: &Session, scene: &Analytic) -> CacheErr
         let at = EstimatePoint {
             p: d * scene.radius,
             n: -d,
+            two_sided: false,
         };
         let e = gathered_irradiance(&maps, &at, &mut scratch);
         for c in 0..3 {

@@ -107,6 +107,11 @@ fn no_sample_for_an_outgoing_direction_in_the_plane() {
             k: Rgb::splat(3.0),
         },
         Material::Dielectric { eta: 1.5 },
+        Material::ThinDielectric { eta: 1.5 },
+        Material::DiffuseTransmission {
+            reflectance: Rgb::splat(0.5),
+            transmittance: Rgb::splat(0.5),
+        },
         Material::Interface,
     ];
     for m in materials {

@@ -854,7 +854,8 @@ fn mis_weighted_direct_light_has_the_mean_of_each_strategy() {
         .intersect(&down_ray, f32::INFINITY)
         .expect("the floor");
     assert_eq!(hit.light, NO_LIGHT);
-    let (material, wo_world) = (world.materials[hit.material as usize], Vec3::Z);
+    let wo_world = Vec3::Z;
+    let material = world.material_at(&hit, wo_world);
     let at = ShadingPoint::new(&hit, material, wo_world);
     let frame = at.frame;
     let ctx = hit.light_sample_context();

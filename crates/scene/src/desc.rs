@@ -155,6 +155,21 @@ pub enum MaterialDesc {
         alpha_u: f32,
         alpha_v: f32,
     },
+    /// `"thindielectric"`: a sheet of index `eta` and negligible thickness.
+    ThinDielectric { eta: f32 },
+    /// `"diffusetransmission"`: Lambertian reflection and transmission, `scale`
+    /// already applied.
+    DiffuseTransmission {
+        reflectance: Rgb,
+        transmittance: Rgb,
+    },
+    /// `"mix"`: at each hit one of two materials, the second with probability `amount`
+    /// (pbrt-v4's convention), chosen by a hash of the hit so that it is the same every
+    /// time the same point is seen from the same direction.
+    Mix {
+        materials: [MaterialId; 2],
+        amount: f32,
+    },
     /// `"interface"`: no surface at all (a boundary between media); rays pass through.
     Interface,
 }

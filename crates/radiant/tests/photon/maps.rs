@@ -86,7 +86,7 @@ fn projection_maps_cover_every_ray_that_hits_a_specular_object() {
                 let Some(hit) = world.intersect(&e.ray, f32::INFINITY) else {
                     continue;
                 };
-                if world.materials[hit.material as usize].is_specular() {
+                if world.material_at(&hit, -e.ray.d).is_specular() {
                     specular += 1;
                     assert!(
                         inside,

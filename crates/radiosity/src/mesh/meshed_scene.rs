@@ -3,8 +3,11 @@
 //! in render space, then split by [`super::face_mesh`] into one shared-vertex patch mesh.
 //!
 //! Per band: exitance `E = pi L` on the emitting side of area lights (Lambertian
-//! emitters), reflectance = the diffuse albedo. Specular materials have no diffuse part
-//! (reflectance 0, one warning). Patches are one-sided: the front is the side the shape's
+//! emitters), reflectance = the diffuse albedo. Other materials are approximated by
+//! their diffuse albedo alone (documented approximation, one warning per material):
+//! `diffusetransmission` by its reflectance (the transmitted part is lost), a `mix` by
+//! the amount-weighted albedo of its two materials, and glass and metals by zero (their
+//! patches absorb; the display follows camera rays through them by their BSDF). Patches are one-sided: the front is the side the shape's
 //! normal points to (pbrt's rules: winding, `ReverseOrientation`, handedness of the
 //! transform, shading normals), which is also the side a one-sided light emits on.
 
@@ -27,6 +30,58 @@ pub struct SurfaceTag {
     pub reflectance: [f64; 3],
     /// Index of the shape among the scene's shapes then the instanced shapes, in order.
     pub shape: u32,
+}
+
+/// The diffuse albedo radiosity gives each material, per band in [0, 1]: a mix's is
+/// the amount-weighted mean of its two materials' (memoised, so shared sub-mixes cost
+/// once; nesting bounded, so a cyclic description cannot recurse forever).
+fn diffuse_albedos(materials: &[MaterialDesc]) -> Vec<[f64; 3]> {
+    fn albedo(
+        materials: &[MaterialDesc],
+        memo: &mut [Option<[f64; 3]>],
+        id: u32,
+        depth: u32,
+    ) -> [f64; 3] {
+        if let Some(a) = memo.get(id as usize).copied().flatten() {
+            return a;
+        }
+        let clamp = |c: radiant_math::color::Rgb| c.to_array().map(|c| (c as f64).clamp(0.0, 1.0));
+        let a = match materials.get(id as usize) {
+            Some(MaterialDesc::Diffuse { reflectance })
+            | Some(MaterialDesc::DiffuseTransmission { reflectance, .. }) => clamp(*reflectance),
+            Some(MaterialDesc::Mix {
+                materials: m,
+                amount,
+            }) if depth < 64 => {
+                let t = (*amount as f64).clamp(0.0, 1.0);
+                let x = albedo(materials, memo, m[0], depth + 1);
+                let y = albedo(materials, memo, m[1], depth + 1);
+                [0, 1, 2].map(|k| (1.0 - t) * x[k] + t * y[k])
+            }
+            _ => [0.0; 3],
+        };
+        if let Some(slot) = memo.get_mut(id as usize) {
+            *slot = Some(a);
+        }
+        a
+    }
+    let mut memo = vec![None; materials.len()];
+    (0..materials.len() as u32)
+        .map(|id| albedo(materials, &mut memo, id, 0))
+        .collect()
+}
+
+/// pbrt's name of a material's type, for messages.
+fn material_type(m: &MaterialDesc) -> &'static str {
+    match m {
+        MaterialDesc::Diffuse { .. } => "diffuse",
+        MaterialDesc::Dielectric { .. } | MaterialDesc::RoughDielectric { .. } => "dielectric",
+        MaterialDesc::Conductor(_) | MaterialDesc::RoughConductor { .. } => "conductor",
+        MaterialDesc::ThinDielectric { .. } => "thindielectric",
+        MaterialDesc::DiffuseTransmission { .. } => "diffusetransmission",
+        MaterialDesc::Mix { .. } => "mix",
+        MaterialDesc::Interface => "interface",
+    }
 }
 
 /// No back-side patch.
@@ -66,7 +121,9 @@ impl RadiosityScene {
     ) -> Result<RadiosityScene, SceneError> {
         let mut warnings = Vec::new();
         let shapes = flatten(desc);
-        let mut specular_at = None;
+        // One warning per non-diffuse material, at the first shape that uses it.
+        let mut approximated = vec![false; desc.materials.len()];
+        let albedos = diffuse_albedos(&desc.materials);
         let mut tags = Vec::new();
         let mut shape_tags = Vec::with_capacity(shapes.len());
         for (k, (shape, _)) in shapes.iter().enumerate() {
@@ -76,19 +133,23 @@ impl RadiosityScene {
                     format!("material index {} out of range", shape.material),
                 ));
             };
-            let reflectance = match material {
-                MaterialDesc::Diffuse { reflectance } => {
-                    reflectance.to_array().map(|c| (c as f64).clamp(0.0, 1.0))
-                }
-                MaterialDesc::Interface => [0.0; 3],
-                MaterialDesc::Dielectric { .. }
-                | MaterialDesc::Conductor(_)
-                | MaterialDesc::RoughDielectric { .. }
-                | MaterialDesc::RoughConductor { .. } => {
-                    specular_at.get_or_insert_with(|| shape.loc.clone());
-                    [0.0; 3]
-                }
-            };
+            let reflectance = albedos[shape.material as usize];
+            let exact = matches!(
+                material,
+                MaterialDesc::Diffuse { .. } | MaterialDesc::Interface
+            );
+            if !exact && !approximated[shape.material as usize] {
+                approximated[shape.material as usize] = true;
+                let [r, g, b] = reflectance;
+                warnings.push(Warning {
+                    loc: shape.loc.clone(),
+                    message: format!(
+                        "radiosity: material {} (\"{}\") is not diffuse; its patches use its diffuse albedo ({r:.3}, {g:.3}, {b:.3}) and its specular, glossy and transmitted light is left out",
+                        shape.material,
+                        material_type(material)
+                    ),
+                });
+            }
             let emission = shape.area_light.as_ref().map_or([0.0; 3], |a| {
                 a.l.to_array()
                     .map(|l| std::f64::consts::PI * l.max(0.0) as f64)
@@ -105,12 +166,6 @@ impl RadiosityScene {
                 shape: k as u32,
             });
             shape_tags.push(Some(tags.len() as u32 - 1));
-        }
-        if let Some(loc) = specular_at {
-            warnings.push(Warning {
-                loc,
-                message: "radiosity: specular and glossy materials (mirror, glass, metal, rough metal and glass) have no diffuse part; their patches absorb all light".into(),
-            });
         }
 
         let total_area: f64 = shapes

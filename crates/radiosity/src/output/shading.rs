@@ -7,7 +7,10 @@
 //! bounce of `n` cosine-distributed rays that read the interpolated `(B - E) / pi` of
 //! the patches they hit (Reichert, "A Two-Pass Radiosity Method Driven by Lights and
 //! Viewer Position", MSc thesis, Cornell 1992; Lischinski, Tampieri & Greenberg 1993).
-//! Specular patches (reflectance 0 in the solve) pass the ray on by their BSDF.
+//! Patches with no diffuse albedo at all (glass, metals; reflectance 0 in the solve)
+//! pass the ray on by their BSDF; every other patch, the approximated non-diffuse
+//! materials included (diffuse transmission, mixes with a diffuse part), shows its
+//! radiosity.
 
 use glam::{DVec3, Vec3};
 
@@ -25,6 +28,16 @@ use radiant_render::light::LightSampleContext;
 use radiant_render::sampler::PixelSample;
 use radiant_render::world::World;
 
+/// True for the patches a camera ray stops at and reads the solution of: those whose
+/// material (or one of a mix's) is Lambertian or has a diffuse albedo, which is what the
+/// solve gave them; the rest are followed by their BSDF.
+fn shown_by_radiosity(world: &World, material: u32) -> bool {
+    world
+        .material_weights(material)
+        .iter()
+        .any(|(m, w)| *w > 0.0 && (m.is_diffuse() || !m.diffuse_albedo().is_black()))
+}
+
 /// Specular bounces a camera path follows unless told otherwise.
 const DEFAULT_SPECULAR_DEPTH: u32 = 8;
 
@@ -39,6 +52,8 @@ pub struct Shading<'a> {
     vertex_radiosity: Vec<[f32; 3]>,
     final_gather: u32,
     specular_depth: u32,
+    /// Per material entry: [`shown_by_radiosity`].
+    shown: Vec<bool>,
 }
 
 impl<'a> Shading<'a> {
@@ -75,6 +90,9 @@ impl<'a> Shading<'a> {
             vertex_radiosity,
             final_gather,
             specular_depth: DEFAULT_SPECULAR_DEPTH,
+            shown: (0..world.materials.len() as u32)
+                .map(|m| shown_by_radiosity(world, m))
+                .collect(),
         }
     }
 
@@ -143,9 +161,11 @@ impl<'a> Shading<'a> {
             };
             // Specular surfaces are two-sided (a ray inside glass meets the back of the
             // sphere's patches); diffuse ones show only their front.
-            let struck_material =
-                self.world.materials[self.scene.tag(hit.struck).material as usize];
-            if !struck_material.is_diffuse() {
+            let struck = self.scene.tag(hit.struck).material;
+            if !self.shown[struck as usize] {
+                let struck_material =
+                    self.world
+                        .resolve_material(struck, hit.p.as_vec3(), -ray.d.normalize());
                 let i = hit.patch.unwrap_or(hit.struck);
                 if hit.patch.is_some() {
                     l += beta * self.emission(i) * inv_pi;
@@ -238,7 +258,7 @@ impl<'a> Shading<'a> {
             };
             let Some(j) = hit.patch else { continue };
             let patch = &self.scene.patches.patches[j];
-            let diffuse = self.world.materials[self.scene.tag(j).material as usize].is_diffuse();
+            let diffuse = self.shown[self.scene.tag(j).material as usize];
             if refine_near && hit.t < near && diffuse {
                 let facing = patch.normal.as_vec3();
                 let (reflected, traced) = self.gather(

@@ -398,7 +398,7 @@ fn radiance_departs_where_its_light_sampling_is_coarse() {
     use radiant_math::hash::{Pcg32, hash_u64s};
     use radiant_render::geometry::Ray;
     use radiant_render::material::Material;
-    use radiant_render::world::{NO_LIGHT, World};
+    use radiant_render::world::{MaterialEntry, NO_LIGHT, World};
     let solved = solved();
     let data = &solved.data;
     let desc = radiance_cornell(data);
@@ -416,7 +416,9 @@ fn radiance_departs_where_its_light_sampling_is_coarse() {
     let radiance = [0, 1, 2].map(|k| data["scene"]["light_radiance_rgb"][k].as_f64().unwrap());
     let area = (x1 - x0) * (z1 - z0);
     let albedo = |m: u32| match world.materials[m as usize] {
-        Material::Diffuse { albedo } => [albedo.r, albedo.g, albedo.b].map(f64::from),
+        MaterialEntry::Bsdf(Material::Diffuse { albedo }) => {
+            [albedo.r, albedo.g, albedo.b].map(f64::from)
+        }
         _ => [0.0; 3],
     };
     // Geometric factor from x (normal n) to the light point y, times the light's area.

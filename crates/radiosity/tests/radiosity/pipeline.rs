@@ -344,3 +344,53 @@ fn curved_bilinear_patches_are_meshed_on_their_surface() {
         );
     }
 }
+
+/// Non-diffuse materials enter the solve with their diffuse albedo alone (a mix with
+/// the amount-weighted albedo of its two materials), each with one warning that names
+/// it, however many shapes use it; Lambertian materials with none.
+#[test]
+fn non_diffuse_materials_use_their_diffuse_albedo_with_one_warning_each() {
+    let quad = |z: f32| {
+        format!(
+            "Shape \"trianglemesh\" \"point3 P\" [ 0 0 {z}  1 0 {z}  1 1 {z}  0 1 {z} ] \"integer indices\" [ 0 1 2  0 2 3 ]\n"
+        )
+    };
+    let text = format!(
+        "WorldBegin\n\
+         AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [ 1 1 1 ]\n{}AttributeEnd\n\
+         MakeNamedMaterial \"white\" \"string type\" \"diffuse\" \"rgb reflectance\" [ 0.8 0.8 0.8 ]\n\
+         MakeNamedMaterial \"metal\" \"string type\" \"conductor\" \"float roughness\" 0.1\n\
+         NamedMaterial \"white\"\n{}\
+         Material \"diffusetransmission\" \"rgb reflectance\" [ 0.3 0.4 0.5 ]\n{}{}\
+         NamedMaterial \"metal\"\n{}\
+         Material \"mix\" \"string materials\" [ \"white\" \"metal\" ] \"float amount\" 0.25\n{}",
+        quad(0.0),
+        quad(1.0),
+        quad(2.0),
+        quad(3.0),
+        quad(4.0),
+        quad(5.0),
+    );
+    let desc = radiant_scene::parse_str(&text, "t.pbrt", std::path::Path::new(".")).unwrap();
+    let scene = RadiosityScene::from_desc(&desc, &settings_with_area(1.0)).unwrap();
+    let msgs: Vec<&str> = scene
+        .warnings
+        .iter()
+        .map(|w| w.message.as_str())
+        .filter(|m| m.contains("is not diffuse"))
+        .collect();
+    assert_eq!(msgs.len(), 3, "{msgs:#?}");
+    for (msg, ty) in msgs.iter().zip(["diffusetransmission", "conductor", "mix"]) {
+        assert!(msg.contains(&format!("(\"{ty}\")")), "{msg}");
+    }
+    let reflectance = |shape: u32| {
+        let tag = scene.tags.iter().find(|t| t.shape == shape).unwrap();
+        tag.reflectance.map(|r| r as f32)
+    };
+    let close = |a: [f32; 3], b: [f32; 3]| (0..3).all(|k| (a[k] - b[k]).abs() < 1e-6);
+    assert!(close(reflectance(1), [0.8; 3]));
+    assert!(close(reflectance(2), [0.3, 0.4, 0.5]));
+    assert!(close(reflectance(3), [0.3, 0.4, 0.5]));
+    assert!(close(reflectance(4), [0.0; 3]));
+    assert!(close(reflectance(5), [0.6; 3]), "{:?}", reflectance(5));
+}

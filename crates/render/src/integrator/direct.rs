@@ -31,7 +31,7 @@ pub struct ShadingPoint<'a> {
 impl<'a> ShadingPoint<'a> {
     /// `hit` with `material`, seen along the unit direction `wo_world`.
     pub fn new(hit: &'a SurfaceHit, material: Material, wo_world: Vec3) -> ShadingPoint<'a> {
-        let frame = Frame::from_normal(hit.ns);
+        let frame = World::shading_frame(hit, &material);
         ShadingPoint {
             hit,
             material,

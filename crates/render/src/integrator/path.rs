@@ -8,7 +8,7 @@ use crate::material::TransportMode;
 use crate::sampler::PixelSample;
 use crate::world::{NO_LIGHT, World};
 use radiant_math::color::Rgb;
-use radiant_math::{Frame, sampling::power_heuristic};
+use radiant_math::sampling::power_heuristic;
 use radiant_scene::{IntegratorDesc, SceneError};
 
 use super::direct;
@@ -147,8 +147,8 @@ pub fn radiance(
         }
         depth += 1;
 
-        let material = world.materials[hit.material as usize];
-        let frame = Frame::from_normal(hit.ns);
+        let material = world.material_at(&hit, wo_world);
+        let frame = World::shading_frame(&hit, &material);
         let wo = frame.to_local(wo_world);
 
         // Drawn for every vertex so that the dimension layout does not depend on the material.

@@ -1,13 +1,16 @@
 //! Materials and their BSDFs, evaluated in the local shading frame (normal = +z).
 //!
 //! The set is closed — Lambertian diffuse, perfect mirror, smooth conductor, smooth
-//! dielectric, rough (microfacet) conductor and dielectric — so it is one enum with
-//! `match`. All are two-sided: a diffuse surface reflects on both sides, a dielectric
+//! dielectric, rough (microfacet) conductor and dielectric, thin dielectric, diffuse
+//! transmission — so it is one enum with `match`. (pbrt-v4's `mix` is not a BSDF but a
+//! choice between two materials per hit; the world resolves it, see
+//! `World::material_at`.) All are two-sided: a diffuse surface reflects on both sides, a dielectric
 //! knows which side it is entered from.
 
 pub mod fresnel;
 pub mod microfacet;
 pub mod rough;
+pub mod thin;
 
 pub use microfacet::TrowbridgeReitz;
 pub use rough::ConductorFresnel;
@@ -45,6 +48,16 @@ pub enum Material {
     RoughDielectric {
         eta: f32,
         distribution: TrowbridgeReitz,
+    },
+    /// A thin dielectric sheet (pbrt-v4's `thindielectric`): a delta BSDF that
+    /// reflects with the sheet's total reflectance R' over its internal bounces and
+    /// transmits straight through (no refraction, no η² scaling).
+    ThinDielectric { eta: f32 },
+    /// Lambertian reflection (`reflectance`/π on the side of `wo`) and Lambertian
+    /// transmission (`transmittance`/π on the other side).
+    DiffuseTransmission {
+        reflectance: Rgb,
+        transmittance: Rgb,
     },
     /// No surface: paths continue straight through.
     Interface,
@@ -109,7 +122,18 @@ impl Material {
                     distribution,
                 }
             }
+            MaterialDesc::ThinDielectric { eta } => Material::ThinDielectric { eta: *eta },
+            MaterialDesc::DiffuseTransmission {
+                reflectance,
+                transmittance,
+            } => Material::DiffuseTransmission {
+                reflectance: reflectance.map(|c| c.clamp(0.0, 1.0)),
+                transmittance: transmittance.map(|c| c.clamp(0.0, 1.0)),
+            },
             MaterialDesc::Interface => Material::Interface,
+            // The world resolves a mix to one of its two materials per hit; its own
+            // table entry is never shaded.
+            MaterialDesc::Mix { .. } => Material::Interface,
         }
     }
 
@@ -120,7 +144,20 @@ impl Material {
             Material::Diffuse { .. }
                 | Material::RoughConductor { .. }
                 | Material::RoughDielectric { .. }
+                | Material::DiffuseTransmission { .. }
         )
+    }
+
+    /// True when the microfacet roughness differs along the two tangent axes, so that
+    /// the shading frame must follow the surface's ∂p/∂u.
+    pub fn is_anisotropic(&self) -> bool {
+        match self {
+            Material::RoughConductor { distribution, .. }
+            | Material::RoughDielectric { distribution, .. } => {
+                distribution.alpha_x != distribution.alpha_y
+            }
+            _ => false,
+        }
     }
 
     /// True where the photon integrators (photon map, SPPM) treat the surface like a
@@ -131,6 +168,12 @@ impl Material {
     /// BSDF evaluated in the estimate (as in pbrt-v4's SPPM).
     pub fn passes_photon_paths(&self) -> bool {
         self.is_specular() || matches!(self, Material::RoughDielectric { .. })
+    }
+
+    /// True where a non-delta BSDF transmits: density estimates there take photons
+    /// from both sides of the surface.
+    pub fn transmits_diffusely(&self) -> bool {
+        matches!(self, Material::DiffuseTransmission { .. })
     }
 
     /// True for the Lambertian material only: what radiosity can mesh and solve.
@@ -152,6 +195,7 @@ impl Material {
     pub fn diffuse_albedo(&self) -> Rgb {
         match self {
             Material::Diffuse { albedo } => *albedo,
+            Material::DiffuseTransmission { reflectance, .. } => *reflectance,
             _ => Rgb::BLACK,
         }
     }
@@ -174,6 +218,10 @@ impl Material {
             Material::RoughDielectric { eta, distribution } => {
                 Rgb::splat(rough::dielectric_eval(distribution, *eta, wo, wi, mode))
             }
+            Material::DiffuseTransmission {
+                reflectance,
+                transmittance,
+            } => thin::diffuse_transmission_eval(*reflectance, *transmittance, wo, wi),
             _ => Rgb::BLACK,
         }
     }
@@ -190,6 +238,10 @@ impl Material {
             Material::RoughDielectric { eta, distribution } => {
                 rough::dielectric_pdf(distribution, *eta, wo, wi)
             }
+            Material::DiffuseTransmission {
+                reflectance,
+                transmittance,
+            } => thin::diffuse_transmission_pdf(*reflectance, *transmittance, wo, wi),
             _ => 0.0,
         }
     }
@@ -228,6 +280,11 @@ impl Material {
             Material::RoughDielectric { eta, distribution } => {
                 rough::dielectric_sample(&distribution, eta, wo, u1, u2, mode)
             }
+            Material::ThinDielectric { eta } => Some(thin::thin_dielectric_sample(wo, eta, u1)),
+            Material::DiffuseTransmission {
+                reflectance,
+                transmittance,
+            } => thin::diffuse_transmission_sample(reflectance, transmittance, wo, u1, u2),
             Material::Interface => Some(BsdfSample {
                 wi: -wo,
                 f: Rgb::splat(1.0 / wo.z.abs()),

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use glam::{Mat3, Vec2, Vec3};
 
 use super::shapes::{BilinearPrim, Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr};
-use super::{NO_LIGHT, World};
+use super::{MAX_MIX_DEPTH, MaterialEntry, NO_LIGHT, World};
 use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
@@ -17,7 +17,8 @@ use crate::light::{
 use crate::material::Material;
 use radiant_math::Transform;
 use radiant_scene::{
-    AreaLightDesc, EnvironmentImage, Geometry, LightDesc, SceneDesc, SceneError, ShapeDesc, Warning,
+    AreaLightDesc, EnvironmentImage, FileLoc, Geometry, LightDesc, MaterialDesc, SceneDesc,
+    SceneError, ShapeDesc, Warning,
 };
 
 /// Errors building the world are scene errors: they name the shape's location.
@@ -29,7 +30,7 @@ impl World {
     pub fn build(desc: &SceneDesc) -> Result<(World, Vec<Warning>), BuildError> {
         check_capacity(desc)?;
         let mut warnings = Vec::new();
-        let materials: Vec<Material> = desc.materials.iter().map(Material::from_desc).collect();
+        let materials = material_table(&desc.materials)?;
         let mut lights = Vec::new();
 
         let mut prototypes = Vec::with_capacity(desc.objects.len());
@@ -244,7 +245,65 @@ fn is_similarity(xf: &Transform) -> bool {
         && m.y_axis.dot(m.z_axis).abs() < tol * a
 }
 
-/// Adds one shape's primitives; area lights go to `lights` (None inside prototypes).
+/// The world's material table, entry for entry the description's: BSDFs, and mixes
+/// that refer to other entries (checked to be in range and free of cycles).
+fn material_table(descs: &[MaterialDesc]) -> Result<Vec<MaterialEntry>, BuildError> {
+    let table: Vec<MaterialEntry> = descs
+        .iter()
+        .map(|d| match d {
+            MaterialDesc::Mix { materials, amount } => MaterialEntry::Mix {
+                materials: *materials,
+                amount: *amount,
+            },
+            d => MaterialEntry::Bsdf(Material::from_desc(d)),
+        })
+        .collect();
+    let refuse = |msg: String| SceneError::at(&FileLoc::builtin("materials"), msg);
+    // Nesting depth of each entry, memoised; past the bound means a cycle (or nesting
+    // far beyond any real scene), and the recursion never goes deeper than the bound.
+    fn depth(table: &[MaterialEntry], memo: &mut [Option<usize>], i: u32, level: usize) -> usize {
+        if level > MAX_MIX_DEPTH {
+            return level;
+        }
+        if let Some(d) = memo[i as usize] {
+            return d;
+        }
+        let d = match table[i as usize] {
+            MaterialEntry::Bsdf(_) => 0,
+            MaterialEntry::Mix { materials, .. } => {
+                1 + materials
+                    .iter()
+                    .map(|&m| depth(table, memo, m, level + 1))
+                    .max()
+                    .unwrap_or(0)
+            }
+        };
+        if d <= MAX_MIX_DEPTH {
+            memo[i as usize] = Some(d);
+        }
+        d
+    }
+    for (i, entry) in table.iter().enumerate() {
+        let MaterialEntry::Mix { materials, .. } = entry else {
+            continue;
+        };
+        if let Some(&bad) = materials.iter().find(|&&m| m as usize >= table.len()) {
+            return Err(refuse(format!(
+                "mix material {i} refers to material {bad}, out of range"
+            )));
+        }
+    }
+    let mut memo = vec![None; table.len()];
+    for i in 0..table.len() {
+        if depth(&table, &mut memo, i as u32, 0) > MAX_MIX_DEPTH {
+            return Err(refuse(format!(
+                "mix material {i}: mixes nest more than {MAX_MIX_DEPTH} deep or form a cycle"
+            )));
+        }
+    }
+    Ok(table)
+}
+
 /// Primitive ids are u32 (BVH leaves, hit records); one id stays free as a marker.
 const MAX_PRIMITIVES: u64 = u32::MAX as u64 - 1;
 /// A lower estimate of the memory one primitive takes once built: its vertices and
@@ -281,10 +340,11 @@ fn check_capacity(desc: &SceneDesc) -> Result<(), BuildError> {
     Ok(())
 }
 
+/// Adds one shape's primitives; area lights go to `lights` (None inside prototypes).
 fn add_shape(
     set: &mut ShapeSet,
     shape: &ShapeDesc,
-    materials: &[Material],
+    materials: &[MaterialEntry],
     lights: Option<&mut Vec<Light>>,
     warnings: &mut Vec<Warning>,
 ) -> Result<(), BuildError> {
@@ -300,7 +360,9 @@ fn add_shape(
         None => None,
     };
     // An interface without emission is no surface at all.
-    if materials[material as usize] == Material::Interface && emission.is_none() {
+    if materials[material as usize] == MaterialEntry::Bsdf(Material::Interface)
+        && emission.is_none()
+    {
         return Ok(());
     }
     let xf = shape.render_from_object;
@@ -366,7 +428,10 @@ fn add_shape(
                         .into(),
                 });
             }
-            add_mesh(set, shape, positions, tris, normals, uvs, emission)
+            add_mesh(set, shape, positions, tris, normals, uvs, emission);
+            if let Some(mesh) = set.meshes.last_mut() {
+                mesh.bilinear_halves = true;
+            }
         }
         Geometry::Sphere {
             radius,
@@ -527,5 +592,6 @@ fn add_mesh(
         indices,
         normals: n,
         uvs: uvs.clone(),
+        bilinear_halves: false,
     });
 }

@@ -15,6 +15,9 @@ pub use shapes::ShapeSet;
 use crate::geometry::{Aabb, Ray, SurfacePoint};
 use crate::light::{Light, LightHit, LightSampleContext, LightSampler};
 use crate::material::Material;
+use radiant_math::Frame;
+use radiant_math::color::Rgb;
+use radiant_math::hash::{hash_u64s, u32_to_unit_f32};
 
 /// No light attached (in per-primitive light indices).
 pub const NO_LIGHT: u32 = u32::MAX;
@@ -33,6 +36,10 @@ pub struct SurfaceHit {
     /// Unit shading normal, on the same side as `ng`.
     pub ns: Vec3,
     pub uv: Vec2,
+    /// ∂p/∂u in render space (pbrt's convention per shape): the first tangent axis of
+    /// anisotropic BSDFs. Not normalised; may be zero where the parameterisation is
+    /// degenerate.
+    pub dpdu: Vec3,
     pub material: u32,
     /// Index of the area light of this primitive, or [`NO_LIGHT`].
     pub light: u32,
@@ -74,12 +81,29 @@ impl SurfaceHit {
     }
 }
 
+/// One entry of the world's material table (indexed by [`SurfaceHit::material`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaterialEntry {
+    Bsdf(Material),
+    /// pbrt-v4's `mix`: two other entries; at each hit the second with probability
+    /// `amount`, chosen by a hash of the hit point and the outgoing direction.
+    Mix {
+        materials: [u32; 2],
+        amount: f32,
+    },
+}
+
+/// Bound on the nesting of mixes, so that a cyclic table cannot loop (the builder
+/// refuses cycles; this is the backstop).
+pub(crate) const MAX_MIX_DEPTH: usize = 64;
+
 /// Everything an integrator traces against.
 pub struct World {
     pub(crate) geometry: ShapeSet,
     /// Object prototypes for instancing (in instance space).
     pub(crate) prototypes: Vec<ShapeSet>,
-    pub materials: Vec<Material>,
+    /// Resolve an entry at a hit with [`World::material_at`].
+    pub materials: Vec<MaterialEntry>,
     pub lights: Vec<Light>,
     /// Chooses among `lights` for next-event estimation and photon emission.
     pub light_sampler: LightSampler,
@@ -104,12 +128,84 @@ impl World {
         !self.occluded(&ray, t_max)
     }
 
+    /// The material shading `hit` seen from the unit direction `wo_world`: the
+    /// table entry itself, or for a mix one of its materials (nested mixes resolved in
+    /// turn). Deterministic: the choice is a pure function of the point, the direction
+    /// and the entries, as in pbrt-v4's `MixMaterial::ChooseMaterial`.
+    pub fn material_at(&self, hit: &SurfaceHit, wo_world: Vec3) -> Material {
+        self.resolve_material(hit.material, hit.p, wo_world)
+    }
+
+    /// [`material_at`](Self::material_at) for an entry, point and direction.
+    pub fn resolve_material(&self, mut index: u32, p: Vec3, wo_world: Vec3) -> Material {
+        for _ in 0..=MAX_MIX_DEPTH {
+            match self.materials[index as usize] {
+                MaterialEntry::Bsdf(m) => return m,
+                MaterialEntry::Mix { materials, amount } => {
+                    index = choose_mixed(materials, amount, p, wo_world);
+                }
+            }
+        }
+        unreachable!("the world builder refuses cyclic mixes")
+    }
+
+    /// Every material an entry can resolve to, with its probability (mixes expanded).
+    pub fn material_weights(&self, index: u32) -> Vec<(Material, f32)> {
+        let mut out: Vec<(Material, f32)> = Vec::new();
+        // Level by level, entries reached along several paths merged, so that shared
+        // sub-mixes cost once per level.
+        let mut level = vec![(index, 1.0f32)];
+        for _ in 0..=MAX_MIX_DEPTH {
+            let mut next: Vec<(u32, f32)> = Vec::new();
+            for (i, w) in level {
+                match self.materials[i as usize] {
+                    MaterialEntry::Bsdf(m) => out.push((m, w)),
+                    MaterialEntry::Mix { materials, amount } => {
+                        let a = amount.clamp(0.0, 1.0);
+                        for (n, wn) in [(materials[0], w * (1.0 - a)), (materials[1], w * a)] {
+                            match next.iter_mut().find(|(j, _)| *j == n) {
+                                Some((_, acc)) => *acc += wn,
+                                None => next.push((n, wn)),
+                            }
+                        }
+                    }
+                }
+            }
+            if next.is_empty() {
+                break;
+            }
+            level = next;
+        }
+        out
+    }
+
+    /// The diffuse albedo of an entry: a mix's is the amount-weighted mean of its
+    /// materials' (what radiosity and final gathering use).
+    pub fn diffuse_albedo(&self, index: u32) -> Rgb {
+        self.material_weights(index)
+            .iter()
+            .fold(Rgb::BLACK, |acc, (m, w)| acc + m.diffuse_albedo() * *w)
+    }
+
+    /// The shading frame of `material` at `hit`: about the shading normal, with its
+    /// first axis along ∂p/∂u for anisotropic BSDFs (pbrt's orientation of
+    /// `uroughness`). Isotropic BSDFs do not depend on the tangent, and keep the
+    /// branch-free frame of the normal alone.
+    pub fn shading_frame(hit: &SurfaceHit, material: &Material) -> Frame {
+        if material.is_anisotropic() {
+            Frame::from_normal_tangent(hit.ns, hit.dpdu)
+        } else {
+            Frame::from_normal(hit.ns)
+        }
+    }
+
     /// Bounding spheres (centre, radius) of the specular geometry (mirrors, conductors,
     /// glass, rough glass): one per mesh, quadric or instance that has any.
     pub fn specular_bounds(&self) -> Vec<(Vec3, f32)> {
         let pick = |m: u32| {
-            let m = &self.materials[m as usize];
-            m.passes_photon_paths() && *m != Material::Interface
+            self.material_weights(m)
+                .iter()
+                .any(|(m, w)| *w > 0.0 && m.passes_photon_paths() && *m != Material::Interface)
         };
         self.geometry
             .bounding_spheres_where(&self.prototypes, &pick)
@@ -123,5 +219,36 @@ impl World {
     /// Number of primitives (triangles, spheres, ... and instances) at the top level.
     pub fn primitive_count(&self) -> usize {
         self.geometry.len()
+    }
+}
+
+/// pbrt-v4's choice of a mix's material: u, a hash of the point, the direction and the
+/// two entries, in [0, 1); the second material when u < amount, so that `amount` is the
+/// probability of the second.
+fn choose_mixed(materials: [u32; 2], amount: f32, p: Vec3, wo: Vec3) -> u32 {
+    if amount <= 0.0 {
+        return materials[0];
+    }
+    if amount >= 1.0 {
+        return materials[1];
+    }
+    let bits = |v: Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()].map(u64::from);
+    let [px, py, pz] = bits(p);
+    let [wx, wy, wz] = bits(wo);
+    let h = hash_u64s(&[
+        px,
+        py,
+        pz,
+        wx,
+        wy,
+        wz,
+        u64::from(materials[0]),
+        u64::from(materials[1]),
+    ]);
+    let u = u32_to_unit_f32((h >> 32) as u32);
+    if u < amount {
+        materials[1]
+    } else {
+        materials[0]
     }
 }

@@ -41,6 +41,10 @@ pub(crate) struct MeshAttrs {
     pub indices: Vec<u32>,
     pub normals: Option<Vec<Vec3>>,
     pub uvs: Option<Vec<Vec2>>,
+    /// The triangles are the halves (p00, p10, p11), (p00, p11, p01) of planar
+    /// bilinear patches, in pairs: without `uvs` they take the patch's parameterisation
+    /// (corners (0,0), (1,0), (0,1), (1,1), as pbrt-v4 gives a bilinear patch).
+    pub bilinear_halves: bool,
 }
 
 /// A quadric placed in render space.
@@ -326,6 +330,7 @@ impl ShapeSet {
                 (hit.p, hit.p_error) = transform_point_with_error(to_render, hit.p, hit.p_error);
                 hit.ng = to_render.normal(hit.ng).normalize();
                 hit.ns = to_render.normal(hit.ns).normalize();
+                hit.dpdu = to_render.vector(hit.dpdu);
                 Some(hit)
             }
         }
@@ -382,6 +387,7 @@ impl ShapeSet {
                     ng: n,
                     ns: n,
                     uv,
+                    dpdu: b.patch.tangents(uv).0,
                     material: b.material,
                     light: b.light,
                 }
@@ -393,14 +399,28 @@ impl ShapeSet {
                 n_obj,
                 uv,
             } => {
-                let (xf, material, light, reverse) = match prim {
+                let (xf, material, light, reverse, phi_max) = match prim {
                     PrimRef::Sphere(i) => {
                         let s = &self.spheres[i as usize];
-                        (&s.render_from_object, s.material, s.light, s.reverse)
+                        let phi_max = s.shape.phi_max;
+                        (
+                            &s.render_from_object,
+                            s.material,
+                            s.light,
+                            s.reverse,
+                            phi_max,
+                        )
                     }
                     PrimRef::Disk(i) => {
                         let d = &self.disks[i as usize];
-                        (&d.render_from_object, d.material, d.light, d.reverse)
+                        let phi_max = d.shape.phi_max;
+                        (
+                            &d.render_from_object,
+                            d.material,
+                            d.light,
+                            d.reverse,
+                            phi_max,
+                        )
                     }
                     _ => unreachable!("bilinear patches are handled above; instances are resolved"),
                 };
@@ -409,6 +429,8 @@ impl ShapeSet {
                     n = -n;
                 }
                 let (p, p_error) = transform_point_with_error(xf, p_obj, p_error);
+                // u = φ / φ_max on spheres and disks alike: ∂p/∂u = φ_max (−y, x, 0).
+                let dpdu = xf.vector(phi_max * Vec3::new(-p_obj.y, p_obj.x, 0.0));
                 SurfaceHit {
                     t,
                     p,
@@ -416,6 +438,7 @@ impl ShapeSet {
                     ng: n,
                     ns: n,
                     uv,
+                    dpdu,
                     material,
                     light,
                 }
@@ -449,11 +472,17 @@ impl ShapeSet {
                 }
             }
         }
-        let uv = match &mesh.uvs {
-            Some(uvs) => b[0] * uvs[vi[0]] + b[1] * uvs[vi[1]] + b[2] * uvs[vi[2]],
+        let tuv = match &mesh.uvs {
+            Some(uvs) => vi.map(|v| uvs[v]),
+            // The two halves of a planar bilinear patch: (p00, p10, p11), (p00, p11, p01).
+            None if mesh.bilinear_halves && attr.index.is_multiple_of(2) => {
+                [Vec2::ZERO, Vec2::X, Vec2::ONE]
+            }
+            None if mesh.bilinear_halves => [Vec2::ZERO, Vec2::ONE, Vec2::Y],
             // pbrt's default parameterisation: (0,0), (1,0), (1,1).
-            None => Vec2::new(b[1] + b[2], b[2]),
+            None => [Vec2::ZERO, Vec2::X, Vec2::ONE],
         };
+        let uv = b[0] * tuv[0] + b[1] * tuv[1] + b[2] * tuv[2];
         SurfaceHit {
             t,
             p,
@@ -461,10 +490,25 @@ impl ShapeSet {
             ng,
             ns,
             uv,
+            dpdu: triangle_dpdu([p0, p1, p2], tuv),
             material: attr.material,
             light: attr.light,
         }
     }
+}
+
+/// ∂p/∂u of a triangle from its vertex uvs (the inverse of the 2×2 uv Jacobian, as in
+/// pbrt-v4's triangle); zero when the uvs are degenerate, so that the shading frame
+/// falls back to an arbitrary tangent.
+fn triangle_dpdu(p: [Vec3; 3], uv: [Vec2; 3]) -> Vec3 {
+    let (duv02, duv12) = (uv[0] - uv[2], uv[1] - uv[2]);
+    let (dp02, dp12) = (p[0] - p[2], p[1] - p[2]);
+    let det = duv02.x * duv12.y - duv02.y * duv12.x;
+    if det.abs() < 1e-9 {
+        return Vec3::ZERO;
+    }
+    let dpdu = (duv12.y * dp02 - duv02.y * dp12) / det;
+    if dpdu.is_finite() { dpdu } else { Vec3::ZERO }
 }
 
 /// The ray in a shape's object space. The direction is not renormalised, so hit

@@ -5,6 +5,11 @@
 //!   d-line index).
 //! - `"conductor"`: `reflectance` (an artist's mirror colour), else `eta` and `k`
 //!   (spectra; default copper, `metal-Cu-eta` / `metal-Cu-k`).
+//! - `"thindielectric"`: `eta` as for `dielectric` (default 1.5).
+//! - `"diffusetransmission"`: `reflectance` and `transmittance` (spectra, default
+//!   0.25), both multiplied by `scale` (float, default 1).
+//! - `"mix"`: `materials` (two named materials, defined before the mix) and `amount`
+//!   (float, default 0.5): the probability of the second material at a hit.
 //! - `"interface"` (also `""`, `"none"`): no surface.
 //! - `dielectric` and `conductor` take pbrt-v4's microfacet roughness: `roughness`
 //!   (default 0) sets both `uroughness` and `vroughness` unless they are given, and
@@ -26,15 +31,12 @@ use crate::spectrum::{interpolate, pairs_from_flat};
 use radiant_math::color::Rgb;
 
 /// pbrt-v4's material types that radiant replaces by diffuse 0.5.
-const FALLBACK_TYPES: [&str; 8] = [
+const FALLBACK_TYPES: [&str; 5] = [
     "coateddiffuse",
     "coatedconductor",
-    "diffusetransmission",
     "hair",
     "measured",
-    "mix",
     "subsurface",
-    "thindielectric",
 ];
 
 /// The d line (nm), where glass catalogues quote their index.
@@ -165,7 +167,7 @@ impl Parser {
                 )?,
             },
             "dielectric" => {
-                let alpha = self.microfacet_alpha(ps, loc, owner)?;
+                let alpha = self.microfacet_alpha(ps, owner)?;
                 let eta = self.dielectric_eta(ps, owner)?;
                 match alpha {
                     None => MaterialDesc::Dielectric { eta },
@@ -177,7 +179,7 @@ impl Parser {
                 }
             }
             "conductor" => {
-                let alpha = self.microfacet_alpha(ps, loc, owner)?;
+                let alpha = self.microfacet_alpha(ps, owner)?;
                 let conductor = if ps.has("reflectance") {
                     let r = self.spectrum_or(
                         ps,
@@ -209,6 +211,21 @@ impl Parser {
                     (Some(_), _) => unreachable!("conductors build a Conductor desc"),
                 }
             }
+            "thindielectric" => MaterialDesc::ThinDielectric {
+                eta: self.dielectric_eta(ps, owner)?,
+            },
+            "diffusetransmission" => {
+                let quarter = Rgb::splat(0.25);
+                let r = self.spectrum_or(ps, "reflectance", SpectrumUse::Albedo, quarter, owner)?;
+                let t =
+                    self.spectrum_or(ps, "transmittance", SpectrumUse::Albedo, quarter, owner)?;
+                let scale = ps.finite_float("scale", 1.0)?;
+                MaterialDesc::DiffuseTransmission {
+                    reflectance: r * scale,
+                    transmittance: t * scale,
+                }
+            }
+            "mix" => self.mix_material(ps, loc, owner)?,
             "interface" | "" | "none" => MaterialDesc::Interface,
             _ if FALLBACK_TYPES.contains(&ty) => {
                 ps.mark_all_used();
@@ -226,6 +243,70 @@ impl Parser {
         })
     }
 
+    /// `mix`: the two named materials (which must be defined already, as the file is
+    /// read in order) and the probability `amount` of the second.
+    fn mix_material(
+        &mut self,
+        ps: &ParamSet,
+        loc: &FileLoc,
+        owner: &str,
+    ) -> Result<MaterialDesc, SceneError> {
+        let materials = match ps.strings("materials")? {
+            Some(([a, b], at)) => {
+                let at = at.clone();
+                let mut id = |name: &str| match self.named_materials.get(name) {
+                    Some(&id) => Ok(id),
+                    None if name.is_empty() || name == "none" => {
+                        Ok(self.push_material(MaterialDesc::Interface))
+                    }
+                    None => Err(SceneError::at(
+                        &at,
+                        format!("{owner}: unknown named material \"{name}\" in \"materials\""),
+                    )),
+                };
+                [id(a)?, id(b)?]
+            }
+            Some((_, at)) => {
+                return Err(SceneError::at(
+                    at,
+                    format!("{owner}: \"string materials\" needs two names"),
+                ));
+            }
+            None => {
+                return Err(SceneError::at(
+                    loc,
+                    format!("{owner} needs \"string materials\" with two names"),
+                ));
+            }
+        };
+        let amount = match ps.lookup("amount").map(|p| (&p.value, p.loc.clone())) {
+            None => 0.5,
+            Some((ParamValue::Float(v), at)) if v.len() == 1 => {
+                if !v[0].is_finite() {
+                    return Err(SceneError::at(&at, "\"amount\" must be finite"));
+                }
+                v[0]
+            }
+            Some((ParamValue::Texture(_), at)) => {
+                self.warn(
+                    &at,
+                    format!("{owner}: textured \"amount\" is not supported; read as 0.5"),
+                );
+                0.5
+            }
+            Some((other, at)) => {
+                return Err(SceneError::at(
+                    &at,
+                    format!(
+                        "parameter \"amount\" has type \"{}\" or the wrong count; expected one float",
+                        other.type_name()
+                    ),
+                ));
+            }
+        };
+        Ok(MaterialDesc::Mix { materials, amount })
+    }
+
     /// The microfacet alphas (u, v) of a dielectric or conductor, or `None` when both
     /// are zero (a smooth surface). pbrt-v4: `roughness` stands for `uroughness` and
     /// `vroughness` where they are absent; `remaproughness` (default true) turns each
@@ -233,7 +314,6 @@ impl Parser {
     fn microfacet_alpha(
         &mut self,
         ps: &ParamSet,
-        loc: &FileLoc,
         owner: &str,
     ) -> Result<Option<(f32, f32)>, SceneError> {
         let remap = ps.bool("remaproughness", true)?;
@@ -276,14 +356,6 @@ impl Parser {
         let (alpha_u, alpha_v) = (to_alpha(u), to_alpha(v));
         if alpha_u == 0.0 && alpha_v == 0.0 {
             return Ok(None);
-        }
-        if alpha_u != alpha_v {
-            self.warn(
-                loc,
-                format!(
-                    "{owner}: anisotropic roughness is oriented along an arbitrary tangent of the shading normal, not the surface's u direction"
-                ),
-            );
         }
         Ok(Some((alpha_u, alpha_v)))
     }

@@ -107,6 +107,9 @@ impl PhotonMap {
 pub struct EstimatePoint {
     pub p: Vec3,
     pub n: Vec3,
+    /// The BSDF transmits diffusely: photons arriving on the far side count too (the
+    /// BSDF, evaluated for them, carries the transmittance).
+    pub two_sided: bool,
 }
 
 /// Reflected radiance at `at` from `map`: the `nbrs.k()` nearest photons within
@@ -125,7 +128,12 @@ pub fn radiance_estimate(
         return Rgb::BLACK;
     }
     map.tree().nearest_where(at.p, max_r2, nbrs, |ph| {
-        ph.flags & skip_flags == 0 && ph.wi().dot(at.n) > 0.0 && ph.normal().dot(at.n) > NORMAL_COS
+        ph.flags & skip_flags == 0
+            && if at.two_sided {
+                ph.normal().dot(at.n).abs() > NORMAL_COS
+            } else {
+                ph.wi().dot(at.n) > 0.0 && ph.normal().dot(at.n) > NORMAL_COS
+            }
     });
     if nbrs.is_empty() {
         return Rgb::BLACK;
@@ -194,7 +202,11 @@ mod tests {
                     0.0,
                     20.0 + rng.uniform() * 60.0,
                 );
-                let at = EstimatePoint { p, n: Vec3::Y };
+                let at = EstimatePoint {
+                    p,
+                    n: Vec3::Y,
+                    two_sided: false,
+                };
                 sum += radiance_estimate(&map, &at, 100.0, kernel, 0, &mut nbrs, |_| Rgb::WHITE).g
                     as f64;
             }
@@ -233,6 +245,7 @@ mod tests {
         let at = EstimatePoint {
             p: Vec3::ZERO,
             n: Vec3::Y,
+            two_sided: false,
         };
         assert_eq!(
             radiance_estimate(&map, &at, 1.0, Kernel::Disc, 0, &mut nbrs, |_| Rgb::WHITE),

@@ -15,11 +15,11 @@ use crate::integrator::direct::{
 };
 use crate::integrator::specular::specular_bounce;
 use crate::light::SceneSphere;
-use crate::material::TransportMode;
+use crate::material::{Material, TransportMode};
 use crate::sampler::PixelSample;
 use crate::world::World;
+use radiant_math::INV_PI;
 use radiant_math::color::Rgb;
-use radiant_math::{Frame, INV_PI};
 use radiant_scene::SamplerKind;
 
 /// Per-thread buffers for lookups, so that camera paths do not allocate.
@@ -83,14 +83,14 @@ pub fn radiance(
         travelled += hit.t * ray.d.length();
         let wo_world = -ray.d.normalize();
         let emitted = surface_emission(world, &hit, wo_world);
-        let material = world.materials[hit.material as usize];
+        let material = world.material_at(&hit, wo_world);
+        let frame = World::shading_frame(&hit, &material);
         if material.passes_photon_paths() {
             // The camera sees emitters directly or through specular chains only.
             l += beta * emitted;
             if depth == settings.max_depth {
                 break;
             }
-            let frame = Frame::from_normal(hit.ns);
             let wo = frame.to_local(wo_world);
             let Some(wi) = specular_bounce(&material, &frame, wo, sampler, &mut beta) else {
                 break;
@@ -101,8 +101,8 @@ pub fn radiance(
         let at = EstimatePoint {
             p: hit.p,
             n: facing(hit.ng, wo_world),
+            two_sided: material.transmits_diffusely(),
         };
-        let frame = Frame::from_normal(hit.ns);
         let wo = frame.to_local(wo_world);
         let bsdf = |wi: Vec3| material.eval(wo, frame.to_local(wi));
         let maps = ctx.maps;
@@ -202,9 +202,9 @@ fn final_gather(
             let Some(y) = world.intersect(&ray, f32::INFINITY) else {
                 break;
             };
-            let mat_y = world.materials[y.material as usize];
             let wo_y_world = -ray.d.normalize();
-            let frame_y = Frame::from_normal(y.ns);
+            let mat_y = world.material_at(&y, wo_y_world);
+            let frame_y = World::shading_frame(&y, &mat_y);
             let wo_y = frame_y.to_local(wo_y_world);
             if mat_y.passes_photon_paths() {
                 let Some(wi) = specular_bounce(&mat_y, &frame_y, wo_y, &mut s, &mut beta) else {
@@ -221,9 +221,23 @@ fn final_gather(
             let at = EstimatePoint {
                 p: y.p,
                 n: facing(y.ng, wo_y_world),
+                two_sided: mat_y.transmits_diffusely(),
             };
-            let irradiance = gathered_irradiance(maps, &at, scratch);
-            sum += beta * (direct.unweighted() + irradiance * mat_y.diffuse_albedo() * INV_PI);
+            let indirect = if let Material::Diffuse { albedo } = mat_y {
+                gathered_irradiance(maps, &at, scratch) * albedo * INV_PI
+            } else {
+                // A glossy (or transmitting) surface reflects the photons' light by its
+                // BSDF, not by an albedo: the two maps' radiance estimates with the BSDF
+                // evaluated per photon (Jensen 2001, §7.5). An irradiance times the
+                // diffuse albedo, zero for a rough metal, would drop all of it.
+                let bsdf = |wi: Vec3| mat_y.eval(wo_y, frame_y.to_local(wi));
+                let estimate = |map, neighbours: &mut _| {
+                    radiance_estimate(map, &at, maps.max_r2, settings.kernel, 0, neighbours, bsdf)
+                };
+                estimate(&maps.global, &mut scratch.global)
+                    + estimate(&maps.caustic, &mut scratch.caustic)
+            };
+            sum += beta * (direct.unweighted() + indirect);
             break;
         }
     }

@@ -91,6 +91,7 @@ impl IrradianceCache {
                         let at = EstimatePoint {
                             p: ph.position(),
                             n: ph.normal(),
+                            two_sided: false,
                         };
                         let e =
                             radiance_estimate(global, &at, max_r2, kernel, 0, &mut g, |_| {

@@ -19,7 +19,6 @@ use crate::geometry::Ray;
 use crate::material::{Material, TransportMode};
 use crate::sampler::PixelSample;
 use crate::world::{SurfaceHit, World};
-use radiant_math::Frame;
 use radiant_math::color::Rgb;
 use radiant_math::hash::hash_u64s;
 use radiant_scene::SamplerKind;
@@ -122,10 +121,10 @@ pub fn trace_photon(
         let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
             break;
         };
-        let material: Material = world.materials[hit.material as usize];
         // Importance transport: the BSDF's "outgoing" direction points back along the
         // photon's path, towards the light.
         let wo_world = -ray.d.normalize();
+        let material: Material = world.material_at(&hit, wo_world);
         if !material.passes_photon_paths() {
             let landing = Landing {
                 hit: &hit,
@@ -139,7 +138,7 @@ pub fn trace_photon(
                 break;
             }
         }
-        let frame = Frame::from_normal(hit.ns);
+        let frame = World::shading_frame(&hit, &material);
         let wo = frame.to_local(wo_world);
         let u_lobe = sampler.get_1d();
         let u_dir = sampler.get_2d();

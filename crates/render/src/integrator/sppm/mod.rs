@@ -36,8 +36,8 @@ use crate::integrator::{
 };
 use hashgrid::HashGrid;
 use radiant_image::{Film, FilmPixel, NonFinite};
+use radiant_math::PI;
 use radiant_math::color::Rgb;
-use radiant_math::{Frame, PI};
 use visible::{CameraSample, camera_sample};
 
 const SPPM_PASS: u64 = 0x5bb3;
@@ -232,11 +232,11 @@ fn render(
                     }
                     let j = e.index;
                     let vp = &samples[j as usize].vp;
-                    if l.wi.dot(vp.n) <= 0.0 {
+                    // Photons from behind count only where the BSDF transmits diffusely.
+                    if l.wi.dot(vp.n) <= 0.0 && !vp.material.transmits_diffusely() {
                         continue;
                     }
-                    let material = &world.materials[vp.material as usize];
-                    let f = material.eval(vp.wo, Frame::from_normal(vp.ns).to_local(l.wi));
+                    let f = vp.material.eval(vp.wo, vp.frame.to_local(l.wi));
                     if !f.is_black() {
                         out.push((j, l.power * f));
                     }

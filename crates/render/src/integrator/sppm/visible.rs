@@ -13,23 +13,40 @@ use glam::Vec3;
 use crate::context::RenderContext;
 use crate::integrator::direct::{ShadingPoint, environment, sample_direct, surface_emission};
 use crate::integrator::specular::specular_bounce;
+use crate::material::Material;
+use crate::world::World;
 use radiant_math::Frame;
 use radiant_math::color::Rgb;
 
 /// A camera path's first diffuse point this iteration.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 pub struct VisiblePoint {
     pub p: Vec3,
     /// Geometric normal turned towards the camera path.
     pub n: Vec3,
-    /// Shading normal (the BSDF frame).
-    pub ns: Vec3,
+    /// The BSDF's shading frame.
+    pub frame: Frame,
     /// Direction to the camera, in the shading frame.
     pub wo: Vec3,
     /// Camera path throughput (camera weight, filter weight, specular chain).
     pub beta: Rgb,
-    pub material: u32,
+    /// The material at the point (a mix already resolved).
+    pub material: Material,
     pub valid: bool,
+}
+
+impl Default for VisiblePoint {
+    fn default() -> VisiblePoint {
+        VisiblePoint {
+            p: Vec3::ZERO,
+            n: Vec3::Z,
+            frame: Frame::from_normal(Vec3::Z),
+            wo: Vec3::Z,
+            beta: Rgb::BLACK,
+            material: Material::Interface,
+            valid: false,
+        }
+    }
 }
 
 /// What a pixel's camera sample found: direct light and a visible point.
@@ -69,8 +86,8 @@ pub fn camera_sample(
         let wo_world = -ray.d.normalize();
         // Only specular vertices precede this one: emission always counts.
         out.ld += beta * surface_emission(world, &hit, wo_world);
-        let material = world.materials[hit.material as usize];
-        let frame = Frame::from_normal(hit.ns);
+        let material = world.material_at(&hit, wo_world);
+        let frame = World::shading_frame(&hit, &material);
         let wo = frame.to_local(wo_world);
         if material.passes_photon_paths() {
             if depth == max_depth {
@@ -95,10 +112,10 @@ pub fn camera_sample(
             } else {
                 -hit.ng
             },
-            ns: hit.ns,
+            frame,
             wo,
             beta,
-            material: hit.material,
+            material,
             valid: true,
         };
         break;
