@@ -67,6 +67,7 @@ impl RadiosityScene {
         let mut warnings = Vec::new();
         let shapes = flatten(desc);
         let mut specular_at = None;
+        let mut coated_at = None;
         let mut tags = Vec::new();
         let mut shape_tags = Vec::with_capacity(shapes.len());
         for (k, (shape, _)) in shapes.iter().enumerate() {
@@ -81,10 +82,18 @@ impl RadiosityScene {
                     reflectance.to_array().map(|c| (c as f64).clamp(0.0, 1.0))
                 }
                 MaterialDesc::Interface => [0.0; 3],
+                MaterialDesc::CoatedDiffuse { .. } => {
+                    coated_at.get_or_insert_with(|| shape.loc.clone());
+                    radiant_render::material::Material::from_desc(material)
+                        .diffuse_albedo()
+                        .to_array()
+                        .map(|c| (c as f64).clamp(0.0, 1.0))
+                }
                 MaterialDesc::Dielectric { .. }
                 | MaterialDesc::Conductor(_)
                 | MaterialDesc::RoughDielectric { .. }
-                | MaterialDesc::RoughConductor { .. } => {
+                | MaterialDesc::RoughConductor { .. }
+                | MaterialDesc::CoatedConductor { .. } => {
                     specular_at.get_or_insert_with(|| shape.loc.clone());
                     [0.0; 3]
                 }
@@ -106,10 +115,16 @@ impl RadiosityScene {
             });
             shape_tags.push(Some(tags.len() as u32 - 1));
         }
+        if let Some(loc) = coated_at {
+            warnings.push(Warning {
+                loc,
+                message: "radiosity: coateddiffuse is solved as Lambertian with the albedo of its base under a smooth coat at normal incidence; the coat's gloss is left out".into(),
+            });
+        }
         if let Some(loc) = specular_at {
             warnings.push(Warning {
                 loc,
-                message: "radiosity: specular and glossy materials (mirror, glass, metal, rough metal and glass) have no diffuse part; their patches absorb all light".into(),
+                message: "radiosity: specular and glossy materials (mirror, glass, metal, rough metal and glass, coated metal) have no diffuse part; their patches absorb all light".into(),
             });
         }
         for light in &desc.lights {

@@ -6,9 +6,11 @@
 //! knows which side it is entered from.
 
 pub mod fresnel;
+pub mod layered;
 pub mod microfacet;
 pub mod rough;
 
+pub use layered::Layered;
 pub use microfacet::TrowbridgeReitz;
 pub use rough::ConductorFresnel;
 
@@ -46,6 +48,11 @@ pub enum Material {
         eta: f32,
         distribution: TrowbridgeReitz,
     },
+    /// A dielectric coat over a Lambertian base (`layers.base` is
+    /// `layered::Base::Diffuse`), evaluated stochastically.
+    CoatedDiffuse { layers: Layered },
+    /// A dielectric coat over a conductor (`layered::Base::Conductor`).
+    CoatedConductor { layers: Layered },
     /// No surface: paths continue straight through.
     Interface,
 }
@@ -109,12 +116,26 @@ impl Material {
                     distribution,
                 }
             }
+            MaterialDesc::CoatedDiffuse { reflectance, coat } => Material::CoatedDiffuse {
+                layers: layered::coated_diffuse(*reflectance, coat),
+            },
+            MaterialDesc::CoatedConductor {
+                conductor,
+                alpha_u,
+                alpha_v,
+                coat,
+            } => Material::CoatedConductor {
+                layers: layered::coated_conductor(conductor, *alpha_u, *alpha_v, coat),
+            },
             MaterialDesc::Interface => Material::Interface,
         }
     }
 
     /// True when the BSDF is a Dirac distribution (no evaluation, only sampling).
     pub fn is_specular(&self) -> bool {
+        if let Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } = self {
+            return layers.is_delta();
+        }
         !matches!(
             self,
             Material::Diffuse { .. }
@@ -152,6 +173,9 @@ impl Material {
     pub fn diffuse_albedo(&self) -> Rgb {
         match self {
             Material::Diffuse { albedo } => *albedo,
+            Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } => {
+                layers.diffuse_albedo()
+            }
             _ => Rgb::BLACK,
         }
     }
@@ -174,6 +198,9 @@ impl Material {
             Material::RoughDielectric { eta, distribution } => {
                 Rgb::splat(rough::dielectric_eval(distribution, *eta, wo, wi, mode))
             }
+            Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } => {
+                layers.eval(wo, wi, mode)
+            }
             _ => Rgb::BLACK,
         }
     }
@@ -189,6 +216,9 @@ impl Material {
             }
             Material::RoughDielectric { eta, distribution } => {
                 rough::dielectric_pdf(distribution, *eta, wo, wi)
+            }
+            Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } => {
+                layers.pdf(wo, wi)
             }
             _ => 0.0,
         }
@@ -227,6 +257,9 @@ impl Material {
             } => rough::conductor_sample(&distribution, &fresnel, wo, u2),
             Material::RoughDielectric { eta, distribution } => {
                 rough::dielectric_sample(&distribution, eta, wo, u1, u2, mode)
+            }
+            Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } => {
+                layers.sample(wo, u1, u2, mode)
             }
             Material::Interface => Some(BsdfSample {
                 wi: -wo,
