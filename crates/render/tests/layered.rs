@@ -141,7 +141,6 @@ fn internal_reflectance(eta: f32) -> f64 {
         .sum()
 }
 
-
 /// What a single interface does to light arriving with direction density `dir`
 /// (from `wo` fixed, or cosine-distributed from inside): the fraction of power it
 /// reflects and the fraction it transmits, by its own sampler (importance transport:
@@ -192,7 +191,12 @@ fn white_furnace_loses_only_truncation_and_microfacet_loss() {
         } else {
             interface_fractions(
                 &single,
-                |rng| -radiant_math::sampling::cosine_hemisphere(Vec2::new(rng.uniform(), rng.uniform())),
+                |rng| {
+                    -radiant_math::sampling::cosine_hemisphere(Vec2::new(
+                        rng.uniform(),
+                        rng.uniform(),
+                    ))
+                },
                 n_mc,
             )
         };
@@ -272,7 +276,12 @@ fn chi2_of(name: &str, m: Material, wo: Vec3, seed: u64) {
             },
             |wi| closure.pdf(wo, wi),
         );
-    assert!(bad.is_empty(), "{name}: {} bad samples, e.g. {}", bad.len(), bad[0]);
+    assert!(
+        bad.is_empty(),
+        "{name}: {} bad samples, e.g. {}",
+        bad.len(),
+        bad[0]
+    );
     report.check(ALPHA, CHI2_TESTS);
 }
 
@@ -297,7 +306,10 @@ fn sampling_follows_the_estimated_pdf() {
                 },
             ),
         ),
-        ("coatedconductor gold 0.2 under 0.3", coated_gold(0.2, coat(0.3))),
+        (
+            "coatedconductor gold 0.2 under 0.3",
+            coated_gold(0.2, coat(0.3)),
+        ),
     ];
     let mut seed = 0;
     for (mname, m) in materials {
@@ -327,7 +339,10 @@ fn expected_bsdf_is_reciprocal() {
                 },
             ),
         ),
-        ("coatedconductor gold 0.2 under 0.3", coated_gold(0.2, coat(0.3))),
+        (
+            "coatedconductor gold 0.2 under 0.3",
+            coated_gold(0.2, coat(0.3)),
+        ),
     ];
     let pairs = [
         (direction(0.9, 0.1), direction(0.3, 2.5)),
@@ -368,7 +383,13 @@ fn sample_weights_integrate_eval() {
     let materials = [
         (
             "coateddiffuse rough 0.3, absorbing slab",
-            coated_diffuse(0.9, CoatDesc { thickness: 0.2, ..coat(0.3) }),
+            coated_diffuse(
+                0.9,
+                CoatDesc {
+                    thickness: 0.2,
+                    ..coat(0.3)
+                },
+            ),
         ),
         (
             "coateddiffuse smooth, scattering slab",
@@ -382,8 +403,14 @@ fn sample_weights_integrate_eval() {
                 },
             ),
         ),
-        ("coatedconductor gold 0.2 under 0.3", coated_gold(0.2, coat(0.3))),
-        ("coatedconductor smooth gold under 0.3", coated_gold(0.0, coat(0.3))),
+        (
+            "coatedconductor gold 0.2 under 0.3",
+            coated_gold(0.2, coat(0.3)),
+        ),
+        (
+            "coatedconductor smooth gold under 0.3",
+            coated_gold(0.0, coat(0.3)),
+        ),
     ];
     for (name, m) in materials {
         for (cos_o, mode) in [
@@ -400,7 +427,10 @@ fn sample_weights_integrate_eval() {
             } else {
                 0.0
             };
-            println!("{name}, cos {cos_o}: sampled {mc:.5} ± {se:.5}, quadrature {:.5} ± {quad_noise:.5}", q + delta);
+            println!(
+                "{name}, cos {cos_o}: sampled {mc:.5} ± {se:.5}, quadrature {:.5} ± {quad_noise:.5}",
+                q + delta
+            );
             assert!(mc <= 1.0 + 4.0 * se, "{name}: albedo above 1");
             assert!(
                 (mc - q - delta).abs() < 4.0 * (se * se + quad_noise * quad_noise).sqrt() + 2e-3,
@@ -416,7 +446,9 @@ fn smooth_coat_over_smooth_conductor_is_a_delta() {
     let m = coated_gold(0.0, coat(0.0));
     assert!(m.is_specular() && m.passes_photon_paths());
     let wo = direction(0.6, 0.2);
-    let bs = m.sample(wo, 0.7, Vec2::new(0.3, 0.8), TransportMode::Radiance).unwrap();
+    let bs = m
+        .sample(wo, 0.7, Vec2::new(0.3, 0.8), TransportMode::Radiance)
+        .unwrap();
     assert!(bs.specular && (bs.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-5);
     let rough = coated_diffuse(0.5, coat(0.0));
     assert!(!rough.is_specular() && !rough.passes_photon_paths());

@@ -218,9 +218,7 @@ impl Coat {
             Some(d) => {
                 let bs = rough::dielectric_sample(d, self.eta, a, u1, u, mode)?;
                 let weight = bs.f.g * bs.wi.z.abs() / bs.pdf;
-                weight
-                    .is_finite()
-                    .then_some((bs.wi, weight, bs.pdf, false))
+                weight.is_finite().then_some((bs.wi, weight, bs.pdf, false))
             }
         }
     }
@@ -379,9 +377,7 @@ impl Base {
 
     fn pdf(&self, a: Vec3, b: Vec3) -> f32 {
         match self {
-            Base::Diffuse { .. } if a.z > 0.0 && b.z > 0.0 => {
-                sampling::cosine_hemisphere_pdf(b.z)
-            }
+            Base::Diffuse { .. } if a.z > 0.0 && b.z > 0.0 => sampling::cosine_hemisphere_pdf(b.z),
             Base::Conductor {
                 distribution: Some(d),
                 ..

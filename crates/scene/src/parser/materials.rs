@@ -276,8 +276,10 @@ impl Parser {
             .unwrap_or((0.0, 0.0));
         let eta = self.dielectric_eta(ps, &format!("{prefix}eta"), owner)?;
         let thickness = self.layer_float(ps, "thickness", 0.01, owner)?;
-        if !(thickness > 0.0) {
-            let at = ps.lookup("thickness").map_or(loc.clone(), |p| p.loc.clone());
+        if thickness <= 0.0 {
+            let at = ps
+                .lookup("thickness")
+                .map_or(loc.clone(), |p| p.loc.clone());
             return Err(SceneError::at(
                 &at,
                 format!("\"thickness\" {thickness} must be positive"),
