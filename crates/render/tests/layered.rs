@@ -185,7 +185,7 @@ fn white_furnace_loses_only_truncation_and_microfacet_loss() {
             alpha_u: alpha,
             alpha_v: alpha,
         });
-        let n_mc = 400_000;
+        let n_mc = 200_000;
         let (r, t) = if alpha == 0.0 {
             (r_i, 1.0 - r_i)
         } else {
@@ -221,7 +221,7 @@ fn white_furnace_loses_only_truncation_and_microfacet_loss() {
                 let n = max_depth.div_ceil(2) as i32;
                 let expected = r_o + t_o * t * (1.0 - r.powi(n)) / (1.0 - r);
                 let (mc, se, none) = sampled_albedo(&m, wo, TransportMode::Importance, 200_000);
-                let (quad, quad_noise) = eval_integral(&m, wo, TransportMode::Importance, 150);
+                let (quad, quad_noise) = eval_integral(&m, wo, TransportMode::Importance, 100);
                 // The smooth coat's direct reflection is a delta: not in eval.
                 let quad = quad + if alpha == 0.0 { r_o } else { 0.0 };
                 println!(
@@ -229,14 +229,14 @@ fn white_furnace_loses_only_truncation_and_microfacet_loss() {
                 );
                 assert!(mc <= 1.0 + 4.0 * se && quad <= 1.0 + 4.0 * quad_noise + 2e-3);
                 // The prediction's own Monte Carlo error (rough coat) is of the order
-                // of sqrt(1/n_mc) ~ 1.6e-3 per fraction; the slab absorbs ~1e-6 / cos
+                // of sqrt(1/n_mc) ~ 2.2e-3 per fraction; the slab absorbs ~1e-6 / cos
                 // per crossing.
                 let predicted_error = if alpha == 0.0 { 1e-4 } else { 6e-3 };
                 assert!(
                     (mc - expected).abs() < 4.0 * se + predicted_error,
                     "sampled albedo vs prediction"
                 );
-                // Quadrature: 150 x 300 nodes in angle, discretization below 2e-3.
+                // Quadrature: 100 x 200 nodes in angle, discretization below 2e-3.
                 assert!(
                     (quad - expected).abs() < 4.0 * quad_noise + 2e-3 + predicted_error,
                     "eval quadrature vs prediction"
@@ -285,39 +285,49 @@ fn chi2_of(name: &str, m: Material, wo: Vec3, seed: u64) {
     report.check(ALPHA, CHI2_TESTS);
 }
 
-#[test]
-fn sampling_follows_the_estimated_pdf() {
-    let wos = [
-        ("near normal", direction(0.95, 0.4)),
-        ("oblique", direction(0.5, 2.0)),
-        ("grazing", direction(0.05, 4.0)),
-    ];
-    let materials = [
-        ("coateddiffuse smooth", coated_diffuse(0.8, coat(0.0))),
-        (
-            "coateddiffuse rough 0.3, scattering slab",
-            coated_diffuse(
-                0.8,
-                CoatDesc {
-                    thickness: 0.3,
-                    albedo: Rgb::splat(0.8),
-                    g: 0.4,
-                    ..coat(0.3)
-                },
-            ),
-        ),
-        (
-            "coatedconductor gold 0.2 under 0.3",
-            coated_gold(0.2, coat(0.3)),
-        ),
-    ];
-    let mut seed = 0;
-    for (mname, m) in materials {
-        for (wname, wo) in wos {
-            seed += 1;
-            chi2_of(&format!("{mname}, {wname}"), m, wo, seed);
-        }
+const INCIDENCES: [(&str, f32, f32); 3] = [
+    ("near normal", 0.95, 0.4),
+    ("oblique", 0.5, 2.0),
+    ("grazing", 0.05, 4.0),
+];
+
+fn chi2_at_every_incidence(name: &str, m: Material, seed: u64) {
+    for (k, (which, cos, phi)) in INCIDENCES.into_iter().enumerate() {
+        chi2_of(
+            &format!("{name}, {which}"),
+            m,
+            direction(cos, phi),
+            seed + k as u64,
+        );
     }
+}
+
+#[test]
+fn coated_diffuse_smooth_sampling_follows_its_pdf() {
+    chi2_at_every_incidence("coateddiffuse smooth", coated_diffuse(0.8, coat(0.0)), 1);
+}
+
+#[test]
+fn coated_diffuse_rough_scattering_sampling_follows_its_pdf() {
+    let m = coated_diffuse(
+        0.8,
+        CoatDesc {
+            thickness: 0.3,
+            albedo: Rgb::splat(0.8),
+            g: 0.4,
+            ..coat(0.3)
+        },
+    );
+    chi2_at_every_incidence("coateddiffuse rough 0.3, scattering slab", m, 11);
+}
+
+#[test]
+fn coated_conductor_sampling_follows_its_pdf() {
+    chi2_at_every_incidence(
+        "coatedconductor gold 0.2 under 0.3",
+        coated_gold(0.2, coat(0.3)),
+        21,
+    );
 }
 
 /// The expected BSDF is reciprocal: f(wo, wi) = f(wi, wo) (reflection only, so no η²
