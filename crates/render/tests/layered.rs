@@ -5,7 +5,8 @@
 //! lossless coat keeps all energy but the random walk's truncation and, for a rough
 //! coat, the single-scattering loss of its microfacets, both predicted in closed
 //! form from the coat alone; every albedo at most 1; reciprocity of the expected BSDF;
-//! the mean sample weight equals the quadrature of eval · cos.
+//! the mean sample weight equals the quadrature of eval · cos; the diffuse albedo
+//! approximation against the walk at normal incidence.
 
 use glam::{Vec2, Vec3};
 use radiant_math::color::Rgb;
@@ -469,4 +470,30 @@ fn smooth_coat_over_smooth_conductor_is_a_delta() {
     // Two-sided, opaque.
     assert_eq!(rough.eval(-wo, -wi), rough.eval(wo, wi));
     assert_eq!(rough.eval(wo, -wi), Rgb::BLACK);
+}
+
+/// The diffuse albedo handed to radiosity and the final gather is the closed form of
+/// the smooth coat's internal series at normal incidence: it equals the walk's own
+/// albedo there without the delta reflection, for a thin slab and a deep walk.
+#[test]
+fn diffuse_albedo_is_the_bodys_albedo_at_normal_incidence() {
+    for rho in [0.3f32, 0.8] {
+        let m = coated_diffuse(
+            rho,
+            CoatDesc {
+                thickness: 1e-6,
+                max_depth: 200,
+                ..coat(0.0)
+            },
+        );
+        let (mc, se, _) = sampled_albedo(&m, Vec3::Z, TransportMode::Importance, 200_000);
+        let body = mc - fresnel::dielectric(1.0, 1.5) as f64;
+        let approx = m.diffuse_albedo().g as f64;
+        println!("reflectance {rho}: diffuse_albedo {approx:.5}, sampled body {body:.5} ± {se:.5}");
+        assert!(
+            (approx - body).abs() < 4.0 * se + 1e-3,
+            "{approx} vs {body}"
+        );
+    }
+    assert_eq!(coated_gold(0.2, coat(0.0)).diffuse_albedo(), Rgb::BLACK);
 }
