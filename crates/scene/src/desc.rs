@@ -170,8 +170,42 @@ pub enum MaterialDesc {
         materials: [MaterialId; 2],
         amount: f32,
     },
+    /// pbrt-v4's `coateddiffuse`: a dielectric coat over a Lambertian base of
+    /// `reflectance`.
+    CoatedDiffuse { reflectance: Rgb, coat: CoatDesc },
+    /// pbrt-v4's `coatedconductor`: a dielectric coat over a conductor whose index
+    /// (`ConductorDesc::EtaK`, given relative to vacuum as pbrt reads it) or
+    /// reflectance is as for [`MaterialDesc::Conductor`], with the conductor's own
+    /// microfacet alphas (0: smooth).
+    CoatedConductor {
+        conductor: ConductorDesc,
+        alpha_u: f32,
+        alpha_v: f32,
+        coat: CoatDesc,
+    },
     /// `"interface"`: no surface at all (a boundary between media); rays pass through.
     Interface,
+}
+
+/// The coat and the slab under it of a layered material (pbrt-v4's `coateddiffuse`
+/// and `coatedconductor` parameters).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CoatDesc {
+    /// Index of the coat relative to the outside.
+    pub eta: f32,
+    /// Microfacet alphas of the coat (already remapped; 0: smooth).
+    pub alpha_u: f32,
+    pub alpha_v: f32,
+    /// Thickness of the medium between coat and base, in mean free paths.
+    pub thickness: f32,
+    /// Single-scattering albedo of that medium (0: absorbing only).
+    pub albedo: Rgb,
+    /// Henyey–Greenstein asymmetry of the medium, in (-1, 1).
+    pub g: f32,
+    /// Scattering events of the random walk through the layers.
+    pub max_depth: u32,
+    /// Walks averaged per evaluation.
+    pub samples: u32,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -7,8 +7,8 @@ use radiant_math::{PI, Vec2, Vec3};
 use radiant_scene::named_spectra::metal_spectrum;
 use radiant_scene::spectrum::blackbody_rgb;
 use radiant_scene::{
-    CameraKind, ConductorDesc, FilterKind, Geometry, LightDesc, MaterialDesc, SamplerKind,
-    SceneDesc, parse_str,
+    CameraKind, CoatDesc, ConductorDesc, FilterKind, Geometry, LightDesc, MaterialDesc,
+    SamplerKind, SceneDesc, parse_str,
 };
 
 fn parse(text: &str) -> SceneDesc {
@@ -137,7 +137,7 @@ fn materials_map_to_radiant_materials() {
          Material \"conductor\"\n\
          Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\"\n\
          Material \"conductor\" \"rgb reflectance\" [ 0.9 0.9 0.9 ]\n\
-         Material \"coateddiffuse\" \"rgb reflectance\" [ 1 0 0 ]\n\
+         Material \"hair\" \"rgb reflectance\" [ 1 0 0 ]\n\
          Material \"diffuse\" \"texture reflectance\" \"checks\"\n\
          Material \"interface\"\n",
     );
@@ -175,7 +175,7 @@ fn materials_map_to_radiant_materials() {
         MaterialDesc::Interface,
     ];
     assert_eq!(s.materials, expected);
-    // One warning each: BK7 without dispersion, coateddiffuse, texture.
+    // One warning each: BK7 without dispersion, hair, texture.
     let msgs: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
     assert_eq!(msgs.len(), 3, "{msgs:#?}");
     assert!(msgs[1].contains("diffuse with reflectance 0.5"));
@@ -265,6 +265,88 @@ fn thin_dielectric_diffuse_transmission_and_mix_follow_pbrt_v4() {
     );
     assert!(e.contains("two names"), "{e}");
     assert!(err("WorldBegin\nMaterial \"mix\"\n").contains("string materials"));
+}
+
+#[test]
+fn coated_materials_follow_pbrt_v4() {
+    let s = parse(
+        "WorldBegin\n\
+         Material \"coateddiffuse\"\n\
+         Material \"coateddiffuse\" \"rgb reflectance\" [ 0.2 0.3 0.4 ] \"float roughness\" 0.04\n\
+           \"float thickness\" 0.2 \"float eta\" 1.33 \"rgb albedo\" [ 0.5 0.5 0.5 ] \"float g\" 0.3\n\
+           \"integer maxdepth\" 20 \"integer nsamples\" 4\n\
+         Material \"coatedconductor\" \"float interface.roughness\" 0.01 \"float interface.eta\" 1.4\n\
+           \"spectrum conductor.eta\" \"metal-Au-eta\" \"spectrum conductor.k\" \"metal-Au-k\"\n\
+           \"float conductor.uroughness\" 0.3 \"float conductor.vroughness\" 0.3 \"bool remaproughness\" false\n\
+         Material \"coatedconductor\" \"rgb reflectance\" [ 0.9 0.8 0.7 ]\n\
+         Material \"coateddiffuse\" \"texture thickness\" \"t\"\n",
+    );
+    let pbrt_default = CoatDesc {
+        eta: 1.5,
+        alpha_u: 0.0,
+        alpha_v: 0.0,
+        thickness: 0.01,
+        albedo: Rgb::BLACK,
+        g: 0.0,
+        max_depth: 10,
+        samples: 1,
+    };
+    let expected = vec![
+        MaterialDesc::CoatedDiffuse {
+            reflectance: Rgb::splat(0.5),
+            coat: pbrt_default,
+        },
+        MaterialDesc::CoatedDiffuse {
+            reflectance: Rgb::new(0.2, 0.3, 0.4),
+            coat: CoatDesc {
+                eta: 1.33,
+                alpha_u: 0.2,
+                alpha_v: 0.2,
+                thickness: 0.2,
+                albedo: Rgb::splat(0.5),
+                g: 0.3,
+                max_depth: 20,
+                samples: 4,
+            },
+        },
+        MaterialDesc::CoatedConductor {
+            conductor: ConductorDesc::EtaK {
+                eta: metal_spectrum("metal-Au-eta").unwrap(),
+                k: metal_spectrum("metal-Au-k").unwrap(),
+            },
+            alpha_u: 0.3,
+            alpha_v: 0.3,
+            coat: CoatDesc {
+                eta: 1.4,
+                alpha_u: 0.01,
+                alpha_v: 0.01,
+                ..pbrt_default
+            },
+        },
+        MaterialDesc::CoatedConductor {
+            conductor: ConductorDesc::Reflectance(Rgb::new(0.9, 0.8, 0.7)),
+            alpha_u: 0.0,
+            alpha_v: 0.0,
+            coat: pbrt_default,
+        },
+        MaterialDesc::CoatedDiffuse {
+            reflectance: Rgb::splat(0.5),
+            coat: pbrt_default,
+        },
+    ];
+    assert_eq!(s.materials, expected);
+    // Only the textured thickness is reported; no parameter is left unused.
+    assert_eq!(s.warnings.len(), 1, "{:#?}", s.warnings);
+    assert!(s.warnings[0].message.contains("textured \"thickness\""));
+    for bad in [
+        "\"float thickness\" 0",
+        "\"float g\" 1",
+        "\"integer maxdepth\" 0",
+        "\"integer nsamples\" -1",
+    ] {
+        let e = err(&format!("WorldBegin\nMaterial \"coateddiffuse\" {bad}\n"));
+        assert!(e.contains("error"), "{bad}: {e}");
+    }
 }
 
 #[test]

@@ -49,6 +49,11 @@ fn diffuse_albedos(materials: &[MaterialDesc]) -> Vec<[f64; 3]> {
         let a = match materials.get(id as usize) {
             Some(MaterialDesc::Diffuse { reflectance })
             | Some(MaterialDesc::DiffuseTransmission { reflectance, .. }) => clamp(*reflectance),
+            // The coat's transmittance and inner reflection in closed form (see
+            // `Material::diffuse_albedo`); its gloss is left out.
+            Some(d @ MaterialDesc::CoatedDiffuse { .. }) => {
+                clamp(radiant_render::material::Material::from_desc(d).diffuse_albedo())
+            }
             Some(MaterialDesc::Mix {
                 materials: m,
                 amount,
@@ -80,6 +85,8 @@ fn material_type(m: &MaterialDesc) -> &'static str {
         MaterialDesc::ThinDielectric { .. } => "thindielectric",
         MaterialDesc::DiffuseTransmission { .. } => "diffusetransmission",
         MaterialDesc::Mix { .. } => "mix",
+        MaterialDesc::CoatedDiffuse { .. } => "coateddiffuse",
+        MaterialDesc::CoatedConductor { .. } => "coatedconductor",
         MaterialDesc::Interface => "interface",
     }
 }

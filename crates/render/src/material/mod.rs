@@ -8,10 +8,12 @@
 //! knows which side it is entered from.
 
 pub mod fresnel;
+pub mod layered;
 pub mod microfacet;
 pub mod rough;
 pub mod thin;
 
+pub use layered::Layered;
 pub use microfacet::TrowbridgeReitz;
 pub use rough::ConductorFresnel;
 
@@ -59,6 +61,11 @@ pub enum Material {
         reflectance: Rgb,
         transmittance: Rgb,
     },
+    /// A dielectric coat over a Lambertian base (`layers.base` is
+    /// `layered::Base::Diffuse`), evaluated stochastically.
+    CoatedDiffuse { layers: Layered },
+    /// A dielectric coat over a conductor (`layered::Base::Conductor`).
+    CoatedConductor { layers: Layered },
     /// No surface: paths continue straight through.
     Interface,
 }
@@ -130,6 +137,17 @@ impl Material {
                 reflectance: reflectance.map(|c| c.clamp(0.0, 1.0)),
                 transmittance: transmittance.map(|c| c.clamp(0.0, 1.0)),
             },
+            MaterialDesc::CoatedDiffuse { reflectance, coat } => Material::CoatedDiffuse {
+                layers: layered::coated_diffuse(*reflectance, coat),
+            },
+            MaterialDesc::CoatedConductor {
+                conductor,
+                alpha_u,
+                alpha_v,
+                coat,
+            } => Material::CoatedConductor {
+                layers: layered::coated_conductor(conductor, *alpha_u, *alpha_v, coat),
+            },
             MaterialDesc::Interface => Material::Interface,
             // The world resolves a mix to one of its two materials per hit; its own
             // table entry is never shaded.
@@ -139,6 +157,9 @@ impl Material {
 
     /// True when the BSDF is a Dirac distribution (no evaluation, only sampling).
     pub fn is_specular(&self) -> bool {
+        if let Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } = self {
+            return layers.is_delta();
+        }
         !matches!(
             self,
             Material::Diffuse { .. }
@@ -196,6 +217,9 @@ impl Material {
         match self {
             Material::Diffuse { albedo } => *albedo,
             Material::DiffuseTransmission { reflectance, .. } => *reflectance,
+            Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } => {
+                layers.diffuse_albedo()
+            }
             _ => Rgb::BLACK,
         }
     }
@@ -222,6 +246,9 @@ impl Material {
                 reflectance,
                 transmittance,
             } => thin::diffuse_transmission_eval(*reflectance, *transmittance, wo, wi),
+            Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } => {
+                layers.eval(wo, wi, mode)
+            }
             _ => Rgb::BLACK,
         }
     }
@@ -242,6 +269,9 @@ impl Material {
                 reflectance,
                 transmittance,
             } => thin::diffuse_transmission_pdf(*reflectance, *transmittance, wo, wi),
+            Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } => {
+                layers.pdf(wo, wi)
+            }
             _ => 0.0,
         }
     }
@@ -285,6 +315,9 @@ impl Material {
                 reflectance,
                 transmittance,
             } => thin::diffuse_transmission_sample(reflectance, transmittance, wo, u1, u2),
+            Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } => {
+                layers.sample(wo, u1, u2, mode)
+            }
             Material::Interface => Some(BsdfSample {
                 wi: -wo,
                 f: Rgb::splat(1.0 / wo.z.abs()),

@@ -18,12 +18,24 @@
 //!   non-zero alpha gives `RoughDielectric` / `RoughConductor` (the renderer keeps
 //!   alphas below its smooth threshold a delta BSDF). Textured roughness is reported
 //!   and read as 0.
+//! - `"coateddiffuse"`: a dielectric coat over a Lambertian base: `reflectance`
+//!   (0.5), the coat's `roughness` / `uroughness` / `vroughness` (0) and
+//!   `remaproughness` as above, `eta` (1.5, as for `dielectric`), and the slab between:
+//!   `thickness` (0.01), medium `albedo` (0) and Henyey–Greenstein `g` (0), random
+//!   walk `maxdepth` (10) and `nsamples` (1).
+//! - `"coatedconductor"`: the same coat and slab parameters prefixed `interface.`
+//!   (`interface.roughness`, `interface.eta`, ...; `thickness`, `albedo`, `g`,
+//!   `maxdepth`, `nsamples` without prefix) over a conductor read as `conductor`
+//!   reads it, its parameters prefixed `conductor.` (`conductor.eta` / `conductor.k`,
+//!   default copper, or `reflectance`; `conductor.roughness`, ...).
+//! - Textured floats of the layered materials (`thickness`, `g`) are reported and
+//!   read as their defaults.
 //! - Other material types render as diffuse 0.5 with a warning.
 
 use super::Parser;
 use super::spectrum_param::SpectrumUse;
 use super::state::with_defaults;
-use crate::desc::{ConductorDesc, MaterialDesc, MaterialId};
+use crate::desc::{CoatDesc, ConductorDesc, MaterialDesc, MaterialId};
 use crate::error::{FileLoc, SceneError};
 use crate::named_spectra::{glass_eta, metal_spectrum};
 use crate::params::{ParamSet, ParamValue};
@@ -31,13 +43,7 @@ use crate::spectrum::{interpolate, pairs_from_flat};
 use radiant_math::color::Rgb;
 
 /// pbrt-v4's material types that radiant replaces by diffuse 0.5.
-const FALLBACK_TYPES: [&str; 5] = [
-    "coateddiffuse",
-    "coatedconductor",
-    "hair",
-    "measured",
-    "subsurface",
-];
+const FALLBACK_TYPES: [&str; 3] = ["hair", "measured", "subsurface"];
 
 /// The d line (nm), where glass catalogues quote their index.
 const D_LINE_NM: f64 = 587.6;
@@ -167,8 +173,8 @@ impl Parser {
                 )?,
             },
             "dielectric" => {
-                let alpha = self.microfacet_alpha(ps, owner)?;
-                let eta = self.dielectric_eta(ps, owner)?;
+                let alpha = self.microfacet_alpha(ps, "", owner)?;
+                let eta = self.dielectric_eta(ps, "eta", owner)?;
                 match alpha {
                     None => MaterialDesc::Dielectric { eta },
                     Some((alpha_u, alpha_v)) => MaterialDesc::RoughDielectric {
@@ -179,40 +185,42 @@ impl Parser {
                 }
             }
             "conductor" => {
-                let alpha = self.microfacet_alpha(ps, owner)?;
-                let conductor = if ps.has("reflectance") {
-                    let r = self.spectrum_or(
-                        ps,
-                        "reflectance",
-                        SpectrumUse::Albedo,
-                        Rgb::WHITE,
-                        owner,
-                    )?;
-                    ps.lookup("eta");
-                    ps.lookup("k");
-                    MaterialDesc::Conductor(ConductorDesc::Reflectance(r))
-                } else {
-                    let cu_eta = metal_spectrum("metal-Cu-eta").expect("built-in table");
-                    let cu_k = metal_spectrum("metal-Cu-k").expect("built-in table");
-                    MaterialDesc::Conductor(ConductorDesc::EtaK {
-                        eta: self.spectrum_or(ps, "eta", SpectrumUse::Unbounded, cu_eta, owner)?,
-                        k: self.spectrum_or(ps, "k", SpectrumUse::Unbounded, cu_k, owner)?,
-                    })
-                };
-                match (alpha, conductor) {
-                    (None, c) => c,
-                    (Some((alpha_u, alpha_v)), MaterialDesc::Conductor(conductor)) => {
-                        MaterialDesc::RoughConductor {
-                            conductor,
-                            alpha_u,
-                            alpha_v,
-                        }
-                    }
-                    (Some(_), _) => unreachable!("conductors build a Conductor desc"),
+                let alpha = self.microfacet_alpha(ps, "", owner)?;
+                let conductor = self.conductor_desc(ps, "", owner)?;
+                match alpha {
+                    None => MaterialDesc::Conductor(conductor),
+                    Some((alpha_u, alpha_v)) => MaterialDesc::RoughConductor {
+                        conductor,
+                        alpha_u,
+                        alpha_v,
+                    },
+                }
+            }
+            "coateddiffuse" => MaterialDesc::CoatedDiffuse {
+                reflectance: self.spectrum_or(
+                    ps,
+                    "reflectance",
+                    SpectrumUse::Albedo,
+                    Rgb::splat(0.5),
+                    owner,
+                )?,
+                coat: self.coat_desc(ps, "", loc, owner)?,
+            },
+            "coatedconductor" => {
+                let coat = self.coat_desc(ps, "interface.", loc, owner)?;
+                let (alpha_u, alpha_v) = self
+                    .microfacet_alpha(ps, "conductor.", owner)?
+                    .unwrap_or((0.0, 0.0));
+                let conductor = self.conductor_desc(ps, "conductor.", owner)?;
+                MaterialDesc::CoatedConductor {
+                    conductor,
+                    alpha_u,
+                    alpha_v,
+                    coat,
                 }
             }
             "thindielectric" => MaterialDesc::ThinDielectric {
-                eta: self.dielectric_eta(ps, owner)?,
+                eta: self.dielectric_eta(ps, "eta", owner)?,
             },
             "diffusetransmission" => {
                 let quarter = Rgb::splat(0.25);
@@ -307,17 +315,121 @@ impl Parser {
         Ok(MaterialDesc::Mix { materials, amount })
     }
 
+    /// A conductor's `reflectance`, else its `eta` and `k` (default copper), these
+    /// two named with `prefix` (pbrt-v4 names a coated conductor's colour
+    /// `reflectance`, its index `conductor.eta`).
+    fn conductor_desc(
+        &mut self,
+        ps: &ParamSet,
+        prefix: &str,
+        owner: &str,
+    ) -> Result<ConductorDesc, SceneError> {
+        let name = |n: &str| format!("{prefix}{n}");
+        if ps.has("reflectance") {
+            let r = self.spectrum_or(ps, "reflectance", SpectrumUse::Albedo, Rgb::WHITE, owner)?;
+            ps.lookup(&name("eta"));
+            ps.lookup(&name("k"));
+            return Ok(ConductorDesc::Reflectance(r));
+        }
+        let cu_eta = metal_spectrum("metal-Cu-eta").expect("built-in table");
+        let cu_k = metal_spectrum("metal-Cu-k").expect("built-in table");
+        Ok(ConductorDesc::EtaK {
+            eta: self.spectrum_or(ps, &name("eta"), SpectrumUse::Unbounded, cu_eta, owner)?,
+            k: self.spectrum_or(ps, &name("k"), SpectrumUse::Unbounded, cu_k, owner)?,
+        })
+    }
+
+    /// The coat (roughness and index named with `prefix`) and slab of a layered
+    /// material, with pbrt-v4's defaults.
+    fn coat_desc(
+        &mut self,
+        ps: &ParamSet,
+        prefix: &str,
+        loc: &FileLoc,
+        owner: &str,
+    ) -> Result<CoatDesc, SceneError> {
+        let (alpha_u, alpha_v) = self
+            .microfacet_alpha(ps, prefix, owner)?
+            .unwrap_or((0.0, 0.0));
+        let eta = self.dielectric_eta(ps, &format!("{prefix}eta"), owner)?;
+        let thickness = self.layer_float(ps, "thickness", 0.01, owner)?;
+        if thickness <= 0.0 {
+            let at = ps
+                .lookup("thickness")
+                .map_or(loc.clone(), |p| p.loc.clone());
+            return Err(SceneError::at(
+                &at,
+                format!("\"thickness\" {thickness} must be positive"),
+            ));
+        }
+        let g = self.layer_float(ps, "g", 0.0, owner)?;
+        if !(g > -1.0 && g < 1.0) {
+            let at = ps.lookup("g").map_or(loc.clone(), |p| p.loc.clone());
+            return Err(SceneError::at(
+                &at,
+                format!("\"g\" {g} must lie in (-1, 1)"),
+            ));
+        }
+        let albedo = self.spectrum_or(ps, "albedo", SpectrumUse::Albedo, Rgb::BLACK, owner)?;
+        let max_depth = ps.count("maxdepth", 10)?;
+        let samples = ps.count("nsamples", 1)?;
+        for (name, v) in [("maxdepth", max_depth), ("nsamples", samples)] {
+            if v == 0 || v > u16::MAX as u32 {
+                let at = ps.lookup(name).map_or(loc.clone(), |p| p.loc.clone());
+                return Err(SceneError::at(
+                    &at,
+                    format!("\"{name}\" {v} must lie in 1..=65535"),
+                ));
+            }
+        }
+        Ok(CoatDesc {
+            eta,
+            alpha_u,
+            alpha_v,
+            thickness,
+            albedo: albedo.map(|c| c.clamp(0.0, 1.0)),
+            g,
+            max_depth,
+            samples,
+        })
+    }
+
+    /// A finite float of a layered material; a texture is reported and read as
+    /// `default`.
+    fn layer_float(
+        &mut self,
+        ps: &ParamSet,
+        name: &str,
+        default: f32,
+        owner: &str,
+    ) -> Result<f32, SceneError> {
+        if let Some(p) = ps.lookup(name)
+            && let ParamValue::Texture(_) = &p.value
+        {
+            let at = p.loc.clone();
+            self.warn(
+                &at,
+                format!("{owner}: textured \"{name}\" is not supported; read as {default}"),
+            );
+            return Ok(default);
+        }
+        ps.finite_float(name, default)
+    }
+
     /// The microfacet alphas (u, v) of a dielectric or conductor, or `None` when both
     /// are zero (a smooth surface). pbrt-v4: `roughness` stands for `uroughness` and
     /// `vroughness` where they are absent; `remaproughness` (default true) turns each
-    /// roughness into alpha = sqrt(roughness).
+    /// roughness into alpha = sqrt(roughness). Each name but `remaproughness` carries
+    /// `prefix` (`interface.`, `conductor.` for the layered materials).
     fn microfacet_alpha(
         &mut self,
         ps: &ParamSet,
+        prefix: &str,
         owner: &str,
     ) -> Result<Option<(f32, f32)>, SceneError> {
         let remap = ps.bool("remaproughness", true)?;
         let mut read = |name: &str| -> Result<Option<f32>, SceneError> {
+            let name = &format!("{prefix}{name}");
             let Some(p) = ps.lookup(name) else {
                 return Ok(None);
             };
@@ -360,8 +472,13 @@ impl Parser {
         Ok(Some((alpha_u, alpha_v)))
     }
 
-    fn dielectric_eta(&mut self, ps: &ParamSet, owner: &str) -> Result<f32, SceneError> {
-        let Some(p) = ps.lookup("eta") else {
+    fn dielectric_eta(
+        &mut self,
+        ps: &ParamSet,
+        name: &str,
+        owner: &str,
+    ) -> Result<f32, SceneError> {
+        let Some(p) = ps.lookup(name) else {
             return Ok(1.5);
         };
         let loc = p.loc.clone();
@@ -383,7 +500,7 @@ impl Parser {
                 let pairs = pairs_from_flat(v).ok_or_else(|| {
                     SceneError::at(
                         &loc,
-                        "spectrum \"eta\" needs finite (wavelength, value) pairs",
+                        format!("spectrum \"{name}\" needs finite (wavelength, value) pairs"),
                     )
                 })?;
                 let eta = interpolate(&pairs, D_LINE_NM) as f32;
@@ -406,7 +523,7 @@ impl Parser {
                 return Err(SceneError::at(
                     &loc,
                     format!(
-                        "parameter \"eta\" has type \"{}\" or the wrong count; expected one float or a spectrum",
+                        "parameter \"{name}\" has type \"{}\" or the wrong count; expected one float or a spectrum",
                         other.type_name()
                     ),
                 ));
