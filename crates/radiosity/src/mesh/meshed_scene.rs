@@ -29,6 +29,9 @@ pub struct SurfaceTag {
     pub shape: u32,
 }
 
+/// Point lookups per axis over the (u, v) square for a textured reflectance's mean.
+const TEXTURE_AVERAGE_GRID: u32 = 16;
+
 /// No back-side patch.
 pub const NO_TWIN: u32 = u32::MAX;
 
@@ -65,6 +68,7 @@ impl RadiosityScene {
         settings: &RadiositySettings,
     ) -> Result<RadiosityScene, SceneError> {
         let mut warnings = Vec::new();
+        let textures = radiant_render::texture::TextureSet::build(desc)?;
         let shapes = flatten(desc);
         let mut specular_at = None;
         let mut tags = Vec::new();
@@ -81,6 +85,17 @@ impl RadiosityScene {
                     reflectance.to_array().map(|c| (c as f64).clamp(0.0, 1.0))
                 }
                 MaterialDesc::Interface => [0.0; 3],
+                MaterialDesc::Textured(t) => match t {
+                    // One reflectance per shape: the texture's mean over (u, v).
+                    radiant_scene::TexturedMaterialDesc::Diffuse { reflectance } => textures
+                        .uv_average(*reflectance, TEXTURE_AVERAGE_GRID)
+                        .to_array()
+                        .map(|c| (c as f64).clamp(0.0, 1.0)),
+                    _ => {
+                        specular_at.get_or_insert_with(|| shape.loc.clone());
+                        [0.0; 3]
+                    }
+                },
                 MaterialDesc::Dielectric { .. }
                 | MaterialDesc::Conductor(_)
                 | MaterialDesc::RoughDielectric { .. }

@@ -12,11 +12,29 @@ use crate::light::{
     AreaLight, LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, Light, LightSampler, LightShape,
     SceneSphere,
 };
+use crate::camera::RaySpread;
 use crate::material::Material;
+use crate::texture::{TextureSet, concrete_material};
 use radiant_math::Transform;
 use radiant_scene::{
-    AreaLightDesc, Geometry, LightDesc, SceneDesc, SceneError, ShapeDesc, Warning,
+    AreaLightDesc, Geometry, LightDesc, MaterialDesc, SceneDesc, SceneError, ShapeDesc,
+    TexturedMaterialDesc, TexturedParam, Warning,
 };
+
+/// Point lookups per axis over the (u, v) square for a textured material's mean.
+const AVERAGE_GRID: u32 = 8;
+
+/// A textured material with each texture replaced by its mean over (u, v).
+fn representative(desc: &TexturedMaterialDesc, textures: &TextureSet) -> Material {
+    concrete_material(
+        desc,
+        |p| match p {
+            TexturedParam::Constant(v) => v,
+            TexturedParam::Texture(id) => textures.uv_average(TexturedParam::Texture(id), AVERAGE_GRID).r,
+        },
+        |p| textures.uv_average(p, AVERAGE_GRID),
+    )
+}
 
 /// Errors building the world are scene errors: they name the shape's location.
 pub type BuildError = SceneError;
@@ -26,7 +44,23 @@ impl World {
     /// approximately (they are never silent).
     pub fn build(desc: &SceneDesc) -> Result<(World, Vec<Warning>), BuildError> {
         let mut warnings = Vec::new();
-        let materials: Vec<Material> = desc.materials.iter().map(Material::from_desc).collect();
+        let textures = TextureSet::build(desc)?;
+        let textured: Vec<Option<TexturedMaterialDesc>> = desc
+            .materials
+            .iter()
+            .map(|m| match m {
+                MaterialDesc::Textured(t) => Some(t.clone()),
+                _ => None,
+            })
+            .collect();
+        let materials: Vec<Material> = desc
+            .materials
+            .iter()
+            .map(|m| match m {
+                MaterialDesc::Textured(t) => representative(t, &textures),
+                m => Material::from_desc(m),
+            })
+            .collect();
         let mut lights = Vec::new();
 
         let mut prototypes = Vec::with_capacity(desc.objects.len());
@@ -71,6 +105,9 @@ impl World {
             geometry: top,
             prototypes,
             materials,
+            textured,
+            textures,
+            ray_spread: RaySpread::NONE,
             lights,
             light_sampler,
             bounds,

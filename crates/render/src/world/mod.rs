@@ -12,7 +12,10 @@ use glam::{Vec2, Vec3};
 pub use build::BuildError;
 pub use shapes::ShapeSet;
 
+use crate::camera::RaySpread;
 use crate::geometry::{Aabb, Ray, SurfacePoint};
+use crate::texture::{TextureEvalContext, TextureSet};
+use radiant_scene::TexturedMaterialDesc;
 use crate::light::{Light, LightHit, LightSampleContext, LightSampler};
 use crate::material::Material;
 
@@ -33,6 +36,14 @@ pub struct SurfaceHit {
     /// Unit shading normal, on the same side as `ng`.
     pub ns: Vec3,
     pub uv: Vec2,
+    /// Partial derivatives of `p` with respect to (u, v); zero where the shape does not
+    /// provide them (quadrics and bilinear patches: their textures are point-sampled).
+    pub dpdu: Vec3,
+    pub dpdv: Vec3,
+    /// How `p` moves from one pixel to the next (x, y): the footprint that texture
+    /// filters use. Zero until [`World::add_footprint`] sets it.
+    pub dpdx: Vec3,
+    pub dpdy: Vec3,
     pub material: u32,
     /// Index of the area light of this primitive, or [`NO_LIGHT`].
     pub light: u32,
@@ -78,7 +89,14 @@ pub struct World {
     pub(crate) geometry: ShapeSet,
     /// Object prototypes for instancing (in instance space).
     pub(crate) prototypes: Vec<ShapeSet>,
+    /// The material of each id; for a textured one, its value at the textures' (u, v)
+    /// averages (what queries about the kind of surface see).
     pub materials: Vec<Material>,
+    /// The textured description of each material id that has one.
+    pub(crate) textured: Vec<Option<TexturedMaterialDesc>>,
+    pub textures: TextureSet,
+    /// The camera's pixel footprint along paths, for texture filtering.
+    pub ray_spread: RaySpread,
     pub lights: Vec<Light>,
     /// Chooses among `lights` for next-event estimation and photon emission.
     pub light_sampler: LightSampler,
@@ -101,6 +119,31 @@ impl World {
     pub fn visible(&self, from: &SurfacePoint, to: &SurfacePoint) -> bool {
         let (ray, t_max) = from.spawn_ray_to(to);
         !self.occluded(&ray, t_max)
+    }
+
+    /// True when some material is textured: only then do integrators need footprints.
+    pub fn has_textures(&self) -> bool {
+        self.textured.iter().any(Option::is_some)
+    }
+
+    /// The concrete material at a hit: the table's entry, or for a textured material
+    /// its textures evaluated at the hit with its footprint. `wo` (the direction
+    /// towards the viewer) is for materials that depend on it; textures do not.
+    pub fn material_at(&self, hit: &SurfaceHit, _wo: Vec3) -> Material {
+        match self.textured.get(hit.material as usize) {
+            Some(Some(desc)) => self
+                .textures
+                .material(desc, &TextureEvalContext::from_hit(hit)),
+            _ => self.materials[hit.material as usize],
+        }
+    }
+
+    /// Sets the hit's footprint for a ray of direction `d` that has travelled
+    /// `distance` from the camera (only when textures need it).
+    pub fn add_footprint(&self, hit: &mut SurfaceHit, d: Vec3, distance: f32) {
+        if self.ray_spread != RaySpread::NONE && self.has_textures() {
+            (hit.dpdx, hit.dpdy) = self.ray_spread.differentials(d, distance, hit.ng);
+        }
     }
 
     /// Bounding spheres (centre, radius) of the specular geometry (mirrors, conductors,

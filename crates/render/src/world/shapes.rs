@@ -326,6 +326,8 @@ impl ShapeSet {
                 (hit.p, hit.p_error) = transform_point_with_error(to_render, hit.p, hit.p_error);
                 hit.ng = to_render.normal(hit.ng).normalize();
                 hit.ns = to_render.normal(hit.ns).normalize();
+                hit.dpdu = to_render.vector(hit.dpdu);
+                hit.dpdv = to_render.vector(hit.dpdv);
                 Some(hit)
             }
         }
@@ -382,6 +384,10 @@ impl ShapeSet {
                     ng: n,
                     ns: n,
                     uv,
+                    dpdu: Vec3::ZERO,
+                    dpdv: Vec3::ZERO,
+                    dpdx: Vec3::ZERO,
+                    dpdy: Vec3::ZERO,
                     material: b.material,
                     light: b.light,
                 }
@@ -416,6 +422,10 @@ impl ShapeSet {
                     ng: n,
                     ns: n,
                     uv,
+                    dpdu: Vec3::ZERO,
+                    dpdv: Vec3::ZERO,
+                    dpdx: Vec3::ZERO,
+                    dpdy: Vec3::ZERO,
                     material,
                     light,
                 }
@@ -449,10 +459,27 @@ impl ShapeSet {
                 }
             }
         }
+        // pbrt's default parameterisation: (0,0), (1,0), (1,1).
+        let tri_uv = match &mesh.uvs {
+            Some(uvs) => [uvs[vi[0]], uvs[vi[1]], uvs[vi[2]]],
+            None => [Vec2::ZERO, Vec2::X, Vec2::ONE],
+        };
         let uv = match &mesh.uvs {
-            Some(uvs) => b[0] * uvs[vi[0]] + b[1] * uvs[vi[1]] + b[2] * uvs[vi[2]],
-            // pbrt's default parameterisation: (0,0), (1,0), (1,1).
+            Some(_) => b[0] * tri_uv[0] + b[1] * tri_uv[1] + b[2] * tri_uv[2],
             None => Vec2::new(b[1] + b[2], b[2]),
+        };
+        // ∂p/∂u, ∂p/∂v: the linear map from uv offsets to position offsets across the
+        // triangle (zero when the uvs are degenerate).
+        let (duv02, duv12) = (tri_uv[0] - tri_uv[2], tri_uv[1] - tri_uv[2]);
+        let (dp02, dp12) = (p0 - p2, p1 - p2);
+        let det = duv02.x * duv12.y - duv02.y * duv12.x;
+        let (dpdu, dpdv) = if det.abs() > 1e-12 {
+            (
+                (dp02 * duv12.y - dp12 * duv02.y) / det,
+                (dp12 * duv02.x - dp02 * duv12.x) / det,
+            )
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
         };
         SurfaceHit {
             t,
@@ -461,6 +488,10 @@ impl ShapeSet {
             ng,
             ns,
             uv,
+            dpdu,
+            dpdv,
+            dpdx: Vec3::ZERO,
+            dpdy: Vec3::ZERO,
             material: attr.material,
             light: attr.light,
         }

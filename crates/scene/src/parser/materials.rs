@@ -1,6 +1,6 @@
 //! `Material`, `MakeNamedMaterial`, `NamedMaterial` and `Texture`.
 //!
-//! - `"diffuse"`: `reflectance` (spectrum, default 0.5).
+//! - `"diffuse"`: `reflectance` (spectrum or spectrum texture, default 0.5).
 //! - `"dielectric"`: `eta` (float or spectrum; default 1.5; named glasses become their
 //!   d-line index).
 //! - `"conductor"`: `reflectance` (an artist's mirror colour), else `eta` and `k`
@@ -11,14 +11,17 @@
 //!   `remaproughness` (default true) maps each to the Trowbridge–Reitz alpha as
 //!   alpha = sqrt(roughness); with it false the values are alphas already. Any
 //!   non-zero alpha gives `RoughDielectric` / `RoughConductor` (the renderer keeps
-//!   alphas below its smooth threshold a delta BSDF). Textured roughness is reported
-//!   and read as 0.
+//!   alphas below its smooth threshold a delta BSDF). Roughness may be a float
+//!   texture.
+//! - A material with a texture-valued parameter becomes [`MaterialDesc::Textured`];
+//!   one whose parameters are all constant keeps its plain variant.
 //! - Other material types render as diffuse 0.5 with a warning.
 
 use super::Parser;
 use super::spectrum_param::SpectrumUse;
 use super::state::with_defaults;
 use crate::desc::{ConductorDesc, MaterialDesc, MaterialId};
+use crate::texture::{FloatParam, RoughnessDesc, TexturedMaterialDesc, TexturedParam};
 use crate::error::{FileLoc, SceneError};
 use crate::named_spectra::{glass_eta, metal_spectrum};
 use crate::params::{ParamSet, ParamValue};
@@ -102,20 +105,6 @@ impl Parser {
         }
     }
 
-    /// `Texture "name" "type" "class" params`: read past with one warning.
-    pub(super) fn texture(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
-        let (name, _) = self.string_arg("Texture")?;
-        self.string_arg("Texture")?;
-        let (class, _) = self.string_arg("Texture")?;
-        self.param_list()?.mark_all_used();
-        self.require_world("Texture", loc)?;
-        self.warn(
-            loc,
-            format!("Texture \"{name}\" (\"{class}\"): textures are not supported; materials using it fall back to constants"),
-        );
-        Ok(())
-    }
-
     fn push_material(&mut self, m: MaterialDesc) -> MaterialId {
         self.materials.push(m);
         (self.materials.len() - 1) as MaterialId
@@ -155,25 +144,31 @@ impl Parser {
             }
         }
         Ok(match ty {
-            "diffuse" => MaterialDesc::Diffuse {
-                reflectance: self.spectrum_or(
-                    ps,
-                    "reflectance",
-                    SpectrumUse::Albedo,
-                    Rgb::splat(0.5),
-                    owner,
-                )?,
+            "diffuse" => match self.spectrum_texture_param(
+                ps,
+                "reflectance",
+                SpectrumUse::Albedo,
+                Rgb::splat(0.5),
+            )? {
+                TexturedParam::Constant(reflectance) => MaterialDesc::Diffuse { reflectance },
+                reflectance => MaterialDesc::Textured(TexturedMaterialDesc::Diffuse { reflectance }),
             },
             "dielectric" => {
                 let alpha = self.microfacet_alpha(ps, loc, owner)?;
                 let eta = self.dielectric_eta(ps, owner)?;
                 match alpha {
-                    None => MaterialDesc::Dielectric { eta },
-                    Some((alpha_u, alpha_v)) => MaterialDesc::RoughDielectric {
+                    Alpha::Smooth => MaterialDesc::Dielectric { eta },
+                    Alpha::Constant(alpha_u, alpha_v) => MaterialDesc::RoughDielectric {
                         eta,
                         alpha_u,
                         alpha_v,
                     },
+                    Alpha::Textured(roughness) => {
+                        MaterialDesc::Textured(TexturedMaterialDesc::RoughDielectric {
+                            eta,
+                            roughness,
+                        })
+                    }
                 }
             }
             "conductor" => {
@@ -198,15 +193,21 @@ impl Parser {
                     })
                 };
                 match (alpha, conductor) {
-                    (None, c) => c,
-                    (Some((alpha_u, alpha_v)), MaterialDesc::Conductor(conductor)) => {
+                    (Alpha::Smooth, c) => c,
+                    (Alpha::Constant(alpha_u, alpha_v), MaterialDesc::Conductor(conductor)) => {
                         MaterialDesc::RoughConductor {
                             conductor,
                             alpha_u,
                             alpha_v,
                         }
                     }
-                    (Some(_), _) => unreachable!("conductors build a Conductor desc"),
+                    (Alpha::Textured(roughness), MaterialDesc::Conductor(conductor)) => {
+                        MaterialDesc::Textured(TexturedMaterialDesc::RoughConductor {
+                            conductor,
+                            roughness,
+                        })
+                    }
+                    (_, _) => unreachable!("conductors build a Conductor desc"),
                 }
             }
             "interface" | "" | "none" => MaterialDesc::Interface,
@@ -226,56 +227,43 @@ impl Parser {
         })
     }
 
-    /// The microfacet alphas (u, v) of a dielectric or conductor, or `None` when both
-    /// are zero (a smooth surface). pbrt-v4: `roughness` stands for `uroughness` and
+    /// The microfacet alphas (u, v) of a dielectric or conductor: smooth when both
+    /// are the constant zero. pbrt-v4: `roughness` stands for `uroughness` and
     /// `vroughness` where they are absent; `remaproughness` (default true) turns each
-    /// roughness into alpha = sqrt(roughness).
+    /// roughness into alpha = sqrt(roughness). Any textured roughness keeps all three
+    /// as written, for the renderer to remap per hit.
     fn microfacet_alpha(
         &mut self,
         ps: &ParamSet,
         loc: &FileLoc,
         owner: &str,
-    ) -> Result<Option<(f32, f32)>, SceneError> {
+    ) -> Result<Alpha, SceneError> {
         let remap = ps.bool("remaproughness", true)?;
-        let mut read = |name: &str| -> Result<Option<f32>, SceneError> {
-            let Some(p) = ps.lookup(name) else {
+        let read = |p: &mut Parser, name: &str| -> Result<Option<FloatParam>, SceneError> {
+            if !ps.has(name) {
                 return Ok(None);
-            };
-            match &p.value {
-                ParamValue::Float(v) if v.len() == 1 => {
-                    if v[0].is_finite() && v[0] >= 0.0 {
-                        Ok(Some(v[0]))
-                    } else {
-                        Err(SceneError::at(
-                            &p.loc,
-                            format!("\"{name}\" {} must be finite and >= 0", v[0]),
-                        ))
-                    }
-                }
-                ParamValue::Texture(_) => {
-                    let at = p.loc.clone();
-                    self.warn(
-                        &at,
-                        format!("{owner}: textured \"{name}\" is not supported; read as 0"),
-                    );
-                    Ok(Some(0.0))
-                }
-                other => Err(SceneError::at(
-                    &p.loc,
-                    format!(
-                        "parameter \"{name}\" has type \"{}\" or the wrong count; expected one float",
-                        other.type_name()
-                    ),
-                )),
             }
+            let r = p.float_texture_param(ps, name, 0.0)?;
+            if let TexturedParam::Constant(v) = r
+                && v < 0.0
+            {
+                return Err(SceneError::at(
+                    &ps.lookup(name).expect("present").loc,
+                    format!("\"{name}\" {v} must be finite and >= 0"),
+                ));
+            }
+            Ok(Some(r))
         };
-        let both = read("roughness")?.unwrap_or(0.0);
-        let u = read("uroughness")?.unwrap_or(both);
-        let v = read("vroughness")?.unwrap_or(both);
-        let to_alpha = |r: f32| if remap { r.sqrt() } else { r };
-        let (alpha_u, alpha_v) = (to_alpha(u), to_alpha(v));
+        let both = read(self, "roughness")?.unwrap_or(TexturedParam::Constant(0.0));
+        let u = read(self, "uroughness")?.unwrap_or(both);
+        let v = read(self, "vroughness")?.unwrap_or(both);
+        let roughness = RoughnessDesc { u, v, remap };
+        let (alpha_u, alpha_v) = match (u, v) {
+            (TexturedParam::Constant(u), TexturedParam::Constant(v)) => roughness.alphas(u, v),
+            _ => return Ok(Alpha::Textured(roughness)),
+        };
         if alpha_u == 0.0 && alpha_v == 0.0 {
-            return Ok(None);
+            return Ok(Alpha::Smooth);
         }
         if alpha_u != alpha_v {
             self.warn(
@@ -285,7 +273,7 @@ impl Parser {
                 ),
             );
         }
-        Ok(Some((alpha_u, alpha_v)))
+        Ok(Alpha::Constant(alpha_u, alpha_v))
     }
 
     fn dielectric_eta(&mut self, ps: &ParamSet, owner: &str) -> Result<f32, SceneError> {
@@ -345,4 +333,12 @@ impl Parser {
         }
         Ok(eta)
     }
+}
+
+/// A microfacet material's roughness as read.
+enum Alpha {
+    Smooth,
+    /// Alphas (u, v), already remapped.
+    Constant(f32, f32),
+    Textured(RoughnessDesc),
 }

@@ -76,14 +76,15 @@ pub fn radiance(
     let mut travelled = 0.0f32;
     for depth in 0..=settings.max_depth {
         rays += 1;
-        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+        let Some(mut hit) = world.intersect(&ray, f32::INFINITY) else {
             l += beta * environment(world, ray.d);
             break;
         };
         travelled += hit.t * ray.d.length();
+        world.add_footprint(&mut hit, ray.d, travelled);
         let wo_world = -ray.d.normalize();
         let emitted = surface_emission(world, &hit, wo_world);
-        let material = world.materials[hit.material as usize];
+        let material = world.material_at(&hit, wo_world);
         if material.passes_photon_paths() {
             // The camera sees emitters directly or through specular chains only.
             l += beta * emitted;
@@ -202,8 +203,10 @@ fn final_gather(
             let Some(y) = world.intersect(&ray, f32::INFINITY) else {
                 break;
             };
-            let mat_y = world.materials[y.material as usize];
             let wo_y_world = -ray.d.normalize();
+            // Final-gather rays: point lookups (their footprint is the gather cone's,
+            // not the pixel's).
+            let mat_y = world.material_at(&y, wo_y_world);
             let frame_y = Frame::from_normal(y.ns);
             let wo_y = frame_y.to_local(wo_y_world);
             if mat_y.passes_photon_paths() {

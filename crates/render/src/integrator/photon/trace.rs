@@ -122,7 +122,8 @@ pub fn trace_photon(
         let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
             break;
         };
-        let material: Material = world.materials[hit.material as usize];
+        // Photons carry no pixel footprint: textures are point-sampled.
+        let material: Material = world.material_at(&hit, -ray.d.normalize());
         // Importance transport: the BSDF's "outgoing" direction points back along the
         // photon's path, towards the light.
         let wo_world = -ray.d.normalize();

@@ -218,7 +218,9 @@ fn render(
                     if l.wi.dot(vp.n) <= 0.0 {
                         continue;
                     }
-                    let material = &world.materials[vp.material as usize];
+                    let Some(material) = &vp.material else {
+                        continue;
+                    };
                     let f = material.eval(vp.wo, Frame::from_normal(vp.ns).to_local(l.wi));
                     if !f.is_black() {
                         out.push((j, l.power * f));

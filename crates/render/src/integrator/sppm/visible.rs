@@ -13,6 +13,7 @@ use glam::Vec3;
 use crate::context::RenderContext;
 use crate::integrator::direct::{ShadingPoint, environment, sample_direct, surface_emission};
 use crate::integrator::specular::specular_bounce;
+use crate::material::Material;
 use radiant_math::Frame;
 use radiant_math::color::Rgb;
 
@@ -28,7 +29,8 @@ pub struct VisiblePoint {
     pub wo: Vec3,
     /// Camera path throughput (camera weight, filter weight, specular chain).
     pub beta: Rgb,
-    pub material: u32,
+    /// The surface's material there (textures evaluated); `None` for no point.
+    pub material: Option<Material>,
     pub valid: bool,
 }
 
@@ -60,16 +62,19 @@ pub fn camera_sample(
     let mut ray = cr.ray;
     // The sensor is the film's; the camera path starts with the camera's weight.
     let mut beta = Rgb::splat(cr.weight * cs.filter_weight);
+    let mut travelled = 0.0f32;
     for depth in 0..=max_depth {
         out.rays += 1;
-        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+        let Some(mut hit) = world.intersect(&ray, f32::INFINITY) else {
             out.ld += beta * environment(world, ray.d);
             break;
         };
+        travelled += hit.t * ray.d.length();
+        world.add_footprint(&mut hit, ray.d, travelled);
         let wo_world = -ray.d.normalize();
         // Only specular vertices precede this one: emission always counts.
         out.ld += beta * surface_emission(world, &hit, wo_world);
-        let material = world.materials[hit.material as usize];
+        let material = world.material_at(&hit, wo_world);
         let frame = Frame::from_normal(hit.ns);
         let wo = frame.to_local(wo_world);
         if material.passes_photon_paths() {
@@ -98,7 +103,7 @@ pub fn camera_sample(
             ns: hit.ns,
             wo,
             beta,
-            material: hit.material,
+            material: Some(material),
             valid: true,
         };
         break;
