@@ -141,7 +141,10 @@ pub enum TextureKind {
     /// `value`.
     Constant(Rgb),
     /// `tex * scale`.
-    Scale { tex: SpectrumParam, scale: FloatParam },
+    Scale {
+        tex: SpectrumParam,
+        scale: FloatParam,
+    },
     /// `(1 − amount) tex1 + amount tex2`.
     Mix {
         tex1: SpectrumParam,
@@ -217,10 +220,7 @@ pub enum TexturedMaterialDesc {
     /// Lambertian with a textured `reflectance` (clamped to [0, 1] per channel).
     Diffuse { reflectance: SpectrumParam },
     /// Dielectric of index `eta` with textured roughness.
-    RoughDielectric {
-        eta: f32,
-        roughness: RoughnessDesc,
-    },
+    RoughDielectric { eta: f32, roughness: RoughnessDesc },
     /// Conductor with textured roughness.
     RoughConductor {
         conductor: ConductorDesc,

@@ -51,7 +51,10 @@ impl Level {
 
     /// Half the size, by 2×2 box averages.
     fn downsample(&self) -> Level {
-        let (w, h) = (self.width.div_ceil(2).max(1), self.height.div_ceil(2).max(1));
+        let (w, h) = (
+            self.width.div_ceil(2).max(1),
+            self.height.div_ceil(2).max(1),
+        );
         let at = |x: usize, y: usize| {
             self.texels[y.min(self.height - 1) * self.width + x.min(self.width - 1)]
         };
@@ -137,7 +140,10 @@ pub fn decode(encoding: ColorEncoding, v: f32) -> f32 {
 
 /// Reads an image as linear RGB. `encoding` applies to integer images (default sRGB)
 /// and is ignored for float ones.
-pub fn read_linear(path: &Path, encoding: Option<ColorEncoding>) -> Result<Level, ImageTextureError> {
+pub fn read_linear(
+    path: &Path,
+    encoding: Option<ColorEncoding>,
+) -> Result<Level, ImageTextureError> {
     let err = |message: String| ImageTextureError::Read {
         path: path.to_path_buf(),
         message,
@@ -180,7 +186,9 @@ pub fn read_linear(path: &Path, encoding: Option<ColorEncoding>) -> Result<Level
                 D::ImageLuma16(_) | D::ImageLumaA16(_) | D::ImageRgb16(_) | D::ImageRgba16(_) => {
                     img.to_rgb16()
                         .pixels()
-                        .map(|p| Rgb::from_array([0, 1, 2].map(|c| decode(enc, p[c] as f32 / 65535.0))))
+                        .map(|p| {
+                            Rgb::from_array([0, 1, 2].map(|c| decode(enc, p[c] as f32 / 65535.0)))
+                        })
                         .collect()
                 }
                 _ => {
@@ -188,7 +196,9 @@ pub fn read_linear(path: &Path, encoding: Option<ColorEncoding>) -> Result<Level
                     let lut: Vec<f32> = (0..256).map(|c| decode(enc, c as f32 / 255.0)).collect();
                     img.to_rgb8()
                         .pixels()
-                        .map(|p| Rgb::new(lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize]))
+                        .map(|p| {
+                            Rgb::new(lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize])
+                        })
                         .collect()
                 }
             };

@@ -6,6 +6,7 @@
 //! Float textures are evaluated as grey RGB and read through their first channel,
 //! which for an RGB image is its red channel, as pbrt-v4 reads float image textures.
 
+pub mod bench;
 pub mod filter;
 pub mod image;
 pub mod mapping;
@@ -104,11 +105,11 @@ impl TextureSet {
         let mut images = Vec::with_capacity(desc.textures.len());
         for t in &desc.textures {
             images.push(match &t.kind {
-                TextureKind::ImageMap { image, .. } => Some(
-                    cache
-                        .get(&image.filename, image.encoding)
-                        .map_err(|e| SceneError::at(&t.loc, format!("Texture \"{}\": {e}", t.name)))?,
-                ),
+                TextureKind::ImageMap { image, .. } => {
+                    Some(cache.get(&image.filename, image.encoding).map_err(|e| {
+                        SceneError::at(&t.loc, format!("Texture \"{}\": {e}", t.name))
+                    })?)
+                }
                 _ => None,
             });
         }
@@ -204,7 +205,11 @@ impl TextureSet {
                 mapping: m,
                 octaves,
                 roughness,
-            } => Rgb::splat(procedural::fbm_value(&mapping::map_3d(m, ctx), *octaves, *roughness)),
+            } => Rgb::splat(procedural::fbm_value(
+                &mapping::map_3d(m, ctx),
+                *octaves,
+                *roughness,
+            )),
             TextureKind::Wrinkled {
                 mapping: m,
                 octaves,

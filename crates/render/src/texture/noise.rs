@@ -58,7 +58,9 @@ pub fn noise(p: Vec3) -> f32 {
     let cell = p.floor();
     let f = p - cell;
     // Wrap the lattice period; rem_euclid keeps negative cells in range.
-    let [ix, iy, iz] = cell.to_array().map(|c| (c as i64).rem_euclid(PERIOD as i64) as usize);
+    let [ix, iy, iz] = cell
+        .to_array()
+        .map(|c| (c as i64).rem_euclid(PERIOD as i64) as usize);
     let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
     let a = perm[ix] as usize + iy;
     let aa = perm[a] as usize + iz;
@@ -72,7 +74,11 @@ pub fn noise(p: Vec3) -> f32 {
         lerp(
             v,
             lerp(u, grad(perm[aa], x, y, z), grad(perm[ba], x - 1.0, y, z)),
-            lerp(u, grad(perm[ab], x, y - 1.0, z), grad(perm[bb], x - 1.0, y - 1.0, z)),
+            lerp(
+                u,
+                grad(perm[ab], x, y - 1.0, z),
+                grad(perm[bb], x - 1.0, y - 1.0, z),
+            ),
         ),
         lerp(
             v,

@@ -87,7 +87,13 @@ pub fn windy_value(c: &TexCoord3D) -> f32 {
 
 /// Marble (Perlin 1985): a sine of height perturbed by fBm, through a colour ramp of
 /// pale stone with a few dark veins.
-pub fn marble_value(c: &TexCoord3D, octaves: u32, roughness: f32, scale: f32, variation: f32) -> Rgb {
+pub fn marble_value(
+    c: &TexCoord3D,
+    octaves: u32,
+    roughness: f32,
+    scale: f32,
+    variation: f32,
+) -> Rgb {
     let p = c.p * scale;
     let height = p.y + variation * fbm(p, c.dpdx * scale, c.dpdy * scale, roughness, octaves);
     let x = 0.5 + 0.5 * height.sin();

@@ -5,6 +5,7 @@ use glam::{Mat3, Vec2, Vec3};
 
 use super::shapes::{BilinearPrim, Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr};
 use super::{NO_LIGHT, World};
+use crate::camera::RaySpread;
 use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
@@ -12,7 +13,6 @@ use crate::light::{
     AreaLight, LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, Light, LightSampler, LightShape,
     SceneSphere,
 };
-use crate::camera::RaySpread;
 use crate::material::Material;
 use crate::texture::{TextureSet, concrete_material};
 use radiant_math::Transform;
@@ -30,7 +30,11 @@ fn representative(desc: &TexturedMaterialDesc, textures: &TextureSet) -> Materia
         desc,
         |p| match p {
             TexturedParam::Constant(v) => v,
-            TexturedParam::Texture(id) => textures.uv_average(TexturedParam::Texture(id), AVERAGE_GRID).r,
+            TexturedParam::Texture(id) => {
+                textures
+                    .uv_average(TexturedParam::Texture(id), AVERAGE_GRID)
+                    .r
+            }
         },
         |p| textures.uv_average(p, AVERAGE_GRID),
     )

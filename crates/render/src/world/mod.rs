@@ -14,10 +14,10 @@ pub use shapes::ShapeSet;
 
 use crate::camera::RaySpread;
 use crate::geometry::{Aabb, Ray, SurfacePoint};
-use crate::texture::{TextureEvalContext, TextureSet};
-use radiant_scene::TexturedMaterialDesc;
 use crate::light::{Light, LightHit, LightSampleContext, LightSampler};
 use crate::material::Material;
+use crate::texture::{TextureEvalContext, TextureSet};
+use radiant_scene::TexturedMaterialDesc;
 
 /// No light attached (in per-primitive light indices).
 pub const NO_LIGHT: u32 = u32::MAX;

@@ -21,11 +21,11 @@ use super::Parser;
 use super::spectrum_param::SpectrumUse;
 use super::state::with_defaults;
 use crate::desc::{ConductorDesc, MaterialDesc, MaterialId};
-use crate::texture::{FloatParam, RoughnessDesc, TexturedMaterialDesc, TexturedParam};
 use crate::error::{FileLoc, SceneError};
 use crate::named_spectra::{glass_eta, metal_spectrum};
 use crate::params::{ParamSet, ParamValue};
 use crate::spectrum::{interpolate, pairs_from_flat};
+use crate::texture::{FloatParam, RoughnessDesc, TexturedMaterialDesc, TexturedParam};
 use radiant_math::color::Rgb;
 
 /// pbrt-v4's material types that radiant replaces by diffuse 0.5.
@@ -151,7 +151,9 @@ impl Parser {
                 Rgb::splat(0.5),
             )? {
                 TexturedParam::Constant(reflectance) => MaterialDesc::Diffuse { reflectance },
-                reflectance => MaterialDesc::Textured(TexturedMaterialDesc::Diffuse { reflectance }),
+                reflectance => {
+                    MaterialDesc::Textured(TexturedMaterialDesc::Diffuse { reflectance })
+                }
             },
             "dielectric" => {
                 let alpha = self.microfacet_alpha(ps, loc, owner)?;
@@ -314,7 +316,7 @@ impl Parser {
             ParamValue::Texture(_) => {
                 self.warn(
                     &loc,
-                    format!("{owner}: textures are not supported; eta = 1.5"),
+                    format!("{owner}: a texture for \"eta\" is not supported; eta = 1.5"),
                 );
                 1.5
             }

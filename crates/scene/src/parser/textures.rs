@@ -78,9 +78,10 @@ impl Parser {
         loc: &FileLoc,
         owner: &str,
     ) -> Result<TextureKind, SceneError> {
-        let operand = |p: &mut Parser, name: &str, default: f32| -> Result<SpectrumParam, SceneError> {
-            p.texture_operand(ty, ps, name, default)
-        };
+        let operand =
+            |p: &mut Parser, name: &str, default: f32| -> Result<SpectrumParam, SceneError> {
+                p.texture_operand(ty, ps, name, default)
+            };
         let solid = |p: &Parser| Mapping3D {
             texture_from_render: p.gs.ctm.inverse(),
         };
@@ -108,7 +109,10 @@ impl Parser {
                 let dir = self.gs.ctm.vector(dir).normalize_or_zero();
                 if dir == Vec3::ZERO || !dir.is_finite() {
                     let at = ps.lookup("dir").map_or(loc, |p| &p.loc).clone();
-                    return Err(SceneError::at(&at, format!("{owner}: \"dir\" must be a non-zero vector")));
+                    return Err(SceneError::at(
+                        &at,
+                        format!("{owner}: \"dir\" must be a non-zero vector"),
+                    ));
                 }
                 TextureKind::DirectionMix {
                     tex1: operand(self, "tex1", 0.0)?,
@@ -140,15 +144,14 @@ impl Parser {
                 }
             }
             "bilerp" => {
-                let corner = |p: &mut Parser, name: &str, default: f32| {
-                    match operand(p, name, default)? {
+                let corner =
+                    |p: &mut Parser, name: &str, default: f32| match operand(p, name, default)? {
                         TexturedParam::Constant(c) => Ok(c),
                         TexturedParam::Texture(_) => Err(SceneError::at(
                             &ps.lookup(name).expect("present").loc,
                             format!("{owner}: \"{name}\" must be a constant"),
                         )),
-                    }
-                };
+                    };
                 TextureKind::Bilerp {
                     v00: corner(self, "v00", 0.0)?,
                     v01: corner(self, "v01", 1.0)?,
@@ -442,7 +445,10 @@ impl Parser {
             TextureType::Float => TextureType::Spectrum,
             TextureType::Spectrum => TextureType::Float,
         };
-        if self.named_textures.contains_key(&(other, texture.to_string())) {
+        if self
+            .named_textures
+            .contains_key(&(other, texture.to_string()))
+        {
             return Err(SceneError::at(
                 loc,
                 format!(
@@ -454,7 +460,10 @@ impl Parser {
         }
         Err(SceneError::at(
             loc,
-            format!("\"{param}\" names undefined {} texture \"{texture}\"", ty.name()),
+            format!(
+                "\"{param}\" names undefined {} texture \"{texture}\"",
+                ty.name()
+            ),
         ))
     }
 }
