@@ -378,7 +378,8 @@ fn filtering_a_receding_checkerboard_converges_to_grey_where_point_sampling_alia
 #[test]
 fn mappings_give_their_closed_form_coordinates() {
     // bilerp with these corners returns (s, t, 0): it shows the mapping's coordinates.
-    let corners = "\"rgb v00\" [ 0 0 0 ] \"rgb v10\" [ 1 0 0 ] \"rgb v01\" [ 0 1 0 ] \"rgb v11\" [ 1 1 0 ]";
+    let corners =
+        "\"rgb v00\" [ 0 0 0 ] \"rgb v10\" [ 1 0 0 ] \"rgb v01\" [ 0 1 0 ] \"rgb v11\" [ 1 1 0 ]";
     let (desc, set) = textures(&format!(
         "Texture \"uv\" \"spectrum\" \"bilerp\" {corners} \"float uscale\" 2 \"float vscale\" 3 \"float udelta\" 0.1 \"float vdelta\" -0.2\n\
          Texture \"planar\" \"spectrum\" \"bilerp\" {corners} \"string mapping\" \"planar\" \"vector3 v1\" [ 0 0 1 ] \"vector3 v2\" [ 1 0 0 ] \"float udelta\" 0.25\n\
@@ -393,17 +394,41 @@ fn mappings_give_their_closed_form_coordinates() {
     };
     let near = |a: Vec2, b: Vec2| (a - b).length() < 1e-5;
     let mut ctx = TextureEvalContext::at_uv(Vec2::new(0.2, 0.4));
-    assert!(near(st("uv", &ctx), Vec2::new(0.5, 1.0)), "{}", st("uv", &ctx));
+    assert!(
+        near(st("uv", &ctx), Vec2::new(0.5, 1.0)),
+        "{}",
+        st("uv", &ctx)
+    );
     ctx.p = Vec3::new(0.3, 7.0, 0.2);
-    assert!(near(st("planar", &ctx), Vec2::new(0.45, 0.3)), "{}", st("planar", &ctx));
+    assert!(
+        near(st("planar", &ctx), Vec2::new(0.45, 0.3)),
+        "{}",
+        st("planar", &ctx)
+    );
     // Spherical: s = θ/π from +z, t = φ/2π from +x.
     ctx.p = Vec3::new(0.0, 2.0, 0.0);
-    assert!(near(st("sphere", &ctx), Vec2::new(0.5, 0.25)), "{}", st("sphere", &ctx));
+    assert!(
+        near(st("sphere", &ctx), Vec2::new(0.5, 0.25)),
+        "{}",
+        st("sphere", &ctx)
+    );
     ctx.p = Vec3::new(0.0, 0.0, -3.0);
-    assert!(near(st("sphere", &ctx), Vec2::new(1.0, 0.0)), "{}", st("sphere", &ctx));
+    assert!(
+        near(st("sphere", &ctx), Vec2::new(1.0, 0.0)),
+        "{}",
+        st("sphere", &ctx)
+    );
     // Cylindrical, in the texture's space (translated by 5 along z): s = (π + φ)/2π, t = z.
     ctx.p = Vec3::new(-1.0, 0.0, 5.5);
-    assert!(near(st("cylinder", &ctx), Vec2::new(1.0, 0.5)), "{}", st("cylinder", &ctx));
+    assert!(
+        near(st("cylinder", &ctx), Vec2::new(1.0, 0.5)),
+        "{}",
+        st("cylinder", &ctx)
+    );
     ctx.p = Vec3::new(1.0, 0.0, 5.25);
-    assert!(near(st("cylinder", &ctx), Vec2::new(0.5, 0.25)), "{}", st("cylinder", &ctx));
+    assert!(
+        near(st("cylinder", &ctx), Vec2::new(0.5, 0.25)),
+        "{}",
+        st("cylinder", &ctx)
+    );
 }
