@@ -4,7 +4,9 @@
 //!
 //! Per band: exitance `E = pi L` on the emitting side of area lights (Lambertian
 //! emitters), reflectance = the diffuse albedo. Specular materials have no diffuse part
-//! (reflectance 0, one warning). Patches are one-sided: the front is the side the shape's
+//! (reflectance 0, one warning). A textured diffuse reflectance is reduced to its mean
+//! over the (u, v) square (a 16 × 16 grid of point lookups), one value for all patches
+//! of the shape. Patches are one-sided: the front is the side the shape's
 //! normal points to (pbrt's rules: winding, `ReverseOrientation`, handedness of the
 //! transform, shading normals), which is also the side a one-sided light emits on.
 
