@@ -4,6 +4,7 @@ use clap::Args;
 use radiant::render::accel::{RayBenchConfig, ray_benchmark};
 use radiant::render::bench::{environment_benchmark, render_benchmark, world_ray_benchmark};
 use radiant::render::integrator::photon::bench::photon_benchmark;
+use radiant::render::texture::bench::texture_lookup_benchmark;
 use radiant::scene::builtin::cornell_box;
 
 #[derive(Args, Debug)]
@@ -52,6 +53,9 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         );
         println!("== photon mapping, cornell-caustics");
         println!("{}", photon_benchmark(args.quick));
+        println!("== image texture lookups, 1024x1024 pyramid, anisotropic footprints");
+        let lookups = if args.quick { 200_000 } else { 2_000_000 };
+        println!("{}", texture_lookup_benchmark(lookups, reps));
     });
     Ok(())
 }

@@ -94,7 +94,7 @@ impl RenderContext {
                 format!("a {}x{} film would need {over}", resolution.0, resolution.1),
             ));
         }
-        let (world, w) = World::build(desc)?;
+        let (mut world, w) = World::build(desc)?;
         warnings.extend(w);
         // Nothing to see or nothing to see by: the image will be black, which is worth a
         // word before the render rather than a puzzle after it.
@@ -111,6 +111,8 @@ impl RenderContext {
             });
         }
         let camera = camera::from_desc(&desc.camera, &desc.film, resolution, &mut warnings)?;
+        let spp = overrides.spp.unwrap_or(desc.sampler.pixel_samples).max(1);
+        world.ray_spread = camera::RaySpread::of_camera(&camera, resolution, spp);
         let filter = match desc.filter.kind {
             FilterKind::Box => Filter::box_filter(desc.filter.radius),
             FilterKind::Triangle => Filter::triangle(desc.filter.radius),

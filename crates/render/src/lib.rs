@@ -13,6 +13,7 @@ pub mod integrator;
 pub mod light;
 pub mod material;
 pub mod sampler;
+pub mod texture;
 pub mod world;
 
 pub use context::{CameraSample, Overrides, Progress, RenderContext};

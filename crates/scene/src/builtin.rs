@@ -370,6 +370,7 @@ fn assemble(
         filter,
         integrator,
         materials,
+        textures: Vec::new(),
         shapes,
         objects: Vec::new(),
         instances: Vec::new(),

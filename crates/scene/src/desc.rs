@@ -11,6 +11,7 @@ use glam::{Vec2, Vec3};
 
 use super::error::{FileLoc, Warning};
 use super::params::ParamSet;
+use super::texture::{TextureDesc, TexturedMaterialDesc};
 use radiant_math::Transform;
 use radiant_math::color::Rgb;
 
@@ -23,6 +24,8 @@ pub struct SceneDesc {
     pub filter: FilterDesc,
     pub integrator: IntegratorDesc,
     pub materials: Vec<MaterialDesc>,
+    /// Named textures, referred to by index from textured materials and other textures.
+    pub textures: Vec<TextureDesc>,
     pub shapes: Vec<ShapeDesc>,
     /// Object prototypes (`ObjectBegin`); their shapes are in instance space.
     pub objects: Vec<ObjectDesc>,
@@ -185,6 +188,8 @@ pub enum MaterialDesc {
     },
     /// `"interface"`: no surface at all (a boundary between media); rays pass through.
     Interface,
+    /// A material with texture-valued parameters, made concrete at each hit.
+    Textured(TexturedMaterialDesc),
 }
 
 /// The coat and the slab under it of a layered material (pbrt-v4's `coateddiffuse`

@@ -16,9 +16,11 @@ pub mod parser;
 pub mod ply;
 pub mod spectrum;
 pub mod subdiv;
+pub mod texture;
 pub mod token;
 
 pub use desc::*;
 pub use error::{FileLoc, SceneError, Warning};
 pub use params::{Param, ParamSet, ParamValue};
 pub use parser::{parse_file, parse_str};
+pub use texture::*;

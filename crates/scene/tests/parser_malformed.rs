@@ -13,6 +13,48 @@ fn corpus(name: &str) -> PathBuf {
 /// words the message must contain).
 const CASES: &[(&str, &str, u32, u32, &[&str])] = &[
     (
+        "texture_undefined.pbrt",
+        "texture_undefined.pbrt",
+        2,
+        20,
+        &["\"reflectance\"", "undefined spectrum texture \"nowhere\""],
+    ),
+    (
+        "texture_wrong_type.pbrt",
+        "texture_wrong_type.pbrt",
+        3,
+        20,
+        &["needs a spectrum texture", "\"bumps\" is a float texture"],
+    ),
+    (
+        "texture_missing_image.pbrt",
+        "texture_missing_image.pbrt",
+        3,
+        3,
+        &["no-such-image.png", "not found"],
+    ),
+    (
+        "texture_bad_filter.pbrt",
+        "texture_bad_filter.pbrt",
+        3,
+        3,
+        &["unknown image filter \"gaussian\""],
+    ),
+    (
+        "texture_unknown_class.pbrt",
+        "texture_unknown_class.pbrt",
+        2,
+        1,
+        &["unknown texture class \"plaid\""],
+    ),
+    (
+        "texture_undefined_roughness.pbrt",
+        "texture_undefined_roughness.pbrt",
+        3,
+        46,
+        &["\"uroughness\"", "undefined float texture \"u\""],
+    ),
+    (
         "unknown_directive.pbrt",
         "unknown_directive.pbrt",
         4,

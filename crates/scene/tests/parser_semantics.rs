@@ -8,7 +8,7 @@ use radiant_scene::named_spectra::metal_spectrum;
 use radiant_scene::spectrum::blackbody_rgb;
 use radiant_scene::{
     CameraKind, CoatDesc, ConductorDesc, FilterKind, Geometry, LightDesc, MaterialDesc,
-    SamplerKind, SceneDesc, parse_str,
+    SamplerKind, SceneDesc, TexturedMaterialDesc, TexturedParam, parse_str,
 };
 
 fn parse(text: &str) -> SceneDesc {
@@ -138,6 +138,7 @@ fn materials_map_to_radiant_materials() {
          Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\"\n\
          Material \"conductor\" \"rgb reflectance\" [ 0.9 0.9 0.9 ]\n\
          Material \"hair\" \"rgb reflectance\" [ 1 0 0 ]\n\
+         Texture \"checks\" \"spectrum\" \"checkerboard\"\n\
          Material \"diffuse\" \"texture reflectance\" \"checks\"\n\
          Material \"interface\"\n",
     );
@@ -169,15 +170,15 @@ fn materials_map_to_radiant_materials() {
         MaterialDesc::Diffuse {
             reflectance: Rgb::splat(0.5),
         },
-        MaterialDesc::Diffuse {
-            reflectance: Rgb::splat(0.5),
-        },
+        MaterialDesc::Textured(TexturedMaterialDesc::Diffuse {
+            reflectance: TexturedParam::Texture(0),
+        }),
         MaterialDesc::Interface,
     ];
     assert_eq!(s.materials, expected);
-    // One warning each: BK7 without dispersion, hair, texture.
+    // One warning each: BK7 without dispersion, hair.
     let msgs: Vec<&str> = s.warnings.iter().map(|w| w.message.as_str()).collect();
-    assert_eq!(msgs.len(), 3, "{msgs:#?}");
+    assert_eq!(msgs.len(), 2, "{msgs:#?}");
     assert!(msgs[1].contains("diffuse with reflectance 0.5"));
     assert!(err("WorldBegin\nMaterial \"plastic\"\n").contains("unknown material type"));
 }
@@ -499,7 +500,7 @@ fn unsupported_things_warn_once_each_and_parse_on() {
     let lines: Vec<u32> = s.warnings.iter().map(|w| w.loc.line).collect();
     assert_eq!(
         lines,
-        vec![1, 2, 3, 5, 7, 8, 9, 10, 11, 12],
+        vec![1, 2, 3, 5, 8, 9, 10, 11, 12],
         "{:#?}",
         s.warnings
     );

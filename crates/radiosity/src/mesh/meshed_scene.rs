@@ -7,7 +7,10 @@
 //! their diffuse albedo alone (documented approximation, one warning per material):
 //! `diffusetransmission` by its reflectance (the transmitted part is lost), a `mix` by
 //! the amount-weighted albedo of its two materials, and glass and metals by zero (their
-//! patches absorb; the display follows camera rays through them by their BSDF). Patches are one-sided: the front is the side the shape's
+//! patches absorb; the display follows camera rays through them by their BSDF). A
+//! textured diffuse reflectance is reduced to its mean over the (u, v) square (a 16 × 16
+//! grid of point lookups), one value for all patches of the shape. Patches are one-sided:
+//! the front is the side the shape's
 //! normal points to (pbrt's rules: winding, `ReverseOrientation`, handedness of the
 //! transform, shading normals), which is also the side a one-sided light emits on.
 
@@ -16,8 +19,10 @@ use glam::{DMat4, DVec3, Vec3};
 use super::face_mesh::{FaceMesh, Subdivision};
 use super::patch::PatchSet;
 use crate::settings::{DEFAULT_PATCH_COUNT, RadiositySettings, SolverKind};
+use radiant_render::texture::TextureSet;
 use radiant_scene::{
-    Geometry, MaterialDesc, SceneDesc, SceneError, ShapeDesc, Warning, sphere_z_range,
+    Geometry, MaterialDesc, SceneDesc, SceneError, ShapeDesc, TexturedMaterialDesc, Warning,
+    sphere_z_range,
 };
 
 /// What every patch of one input face carries.
@@ -32,12 +37,16 @@ pub struct SurfaceTag {
     pub shape: u32,
 }
 
+/// Point lookups per axis over the (u, v) square for a textured reflectance's mean.
+const TEXTURE_AVERAGE_GRID: u32 = 16;
+
 /// The diffuse albedo radiosity gives each material, per band in [0, 1]: a mix's is
 /// the amount-weighted mean of its two materials' (memoised, so shared sub-mixes cost
 /// once; nesting bounded, so a cyclic description cannot recurse forever).
-fn diffuse_albedos(materials: &[MaterialDesc]) -> Vec<[f64; 3]> {
+fn diffuse_albedos(materials: &[MaterialDesc], textures: &TextureSet) -> Vec<[f64; 3]> {
     fn albedo(
         materials: &[MaterialDesc],
+        textures: &TextureSet,
         memo: &mut [Option<[f64; 3]>],
         id: u32,
         depth: u32,
@@ -54,13 +63,17 @@ fn diffuse_albedos(materials: &[MaterialDesc]) -> Vec<[f64; 3]> {
             Some(d @ MaterialDesc::CoatedDiffuse { .. }) => {
                 clamp(radiant_render::material::Material::from_desc(d).diffuse_albedo())
             }
+            // One reflectance per shape: the texture's mean over (u, v).
+            Some(MaterialDesc::Textured(TexturedMaterialDesc::Diffuse { reflectance })) => {
+                clamp(textures.uv_average(*reflectance, TEXTURE_AVERAGE_GRID))
+            }
             Some(MaterialDesc::Mix {
                 materials: m,
                 amount,
             }) if depth < 64 => {
                 let t = (*amount as f64).clamp(0.0, 1.0);
-                let x = albedo(materials, memo, m[0], depth + 1);
-                let y = albedo(materials, memo, m[1], depth + 1);
+                let x = albedo(materials, textures, memo, m[0], depth + 1);
+                let y = albedo(materials, textures, memo, m[1], depth + 1);
                 [0, 1, 2].map(|k| (1.0 - t) * x[k] + t * y[k])
             }
             _ => [0.0; 3],
@@ -72,7 +85,7 @@ fn diffuse_albedos(materials: &[MaterialDesc]) -> Vec<[f64; 3]> {
     }
     let mut memo = vec![None; materials.len()];
     (0..materials.len() as u32)
-        .map(|id| albedo(materials, &mut memo, id, 0))
+        .map(|id| albedo(materials, textures, &mut memo, id, 0))
         .collect()
 }
 
@@ -87,6 +100,9 @@ fn material_type(m: &MaterialDesc) -> &'static str {
         MaterialDesc::Mix { .. } => "mix",
         MaterialDesc::CoatedDiffuse { .. } => "coateddiffuse",
         MaterialDesc::CoatedConductor { .. } => "coatedconductor",
+        MaterialDesc::Textured(TexturedMaterialDesc::Diffuse { .. }) => "diffuse",
+        MaterialDesc::Textured(TexturedMaterialDesc::RoughDielectric { .. }) => "dielectric",
+        MaterialDesc::Textured(TexturedMaterialDesc::RoughConductor { .. }) => "conductor",
         MaterialDesc::Interface => "interface",
     }
 }
@@ -127,10 +143,11 @@ impl RadiosityScene {
         settings: &RadiositySettings,
     ) -> Result<RadiosityScene, SceneError> {
         let mut warnings = Vec::new();
+        let textures = TextureSet::build(desc)?;
         let shapes = flatten(desc);
         // One warning per non-diffuse material, at the first shape that uses it.
         let mut approximated = vec![false; desc.materials.len()];
-        let albedos = diffuse_albedos(&desc.materials);
+        let albedos = diffuse_albedos(&desc.materials, &textures);
         let mut tags = Vec::new();
         let mut shape_tags = Vec::with_capacity(shapes.len());
         for (k, (shape, _)) in shapes.iter().enumerate() {
@@ -143,7 +160,9 @@ impl RadiosityScene {
             let reflectance = albedos[shape.material as usize];
             let exact = matches!(
                 material,
-                MaterialDesc::Diffuse { .. } | MaterialDesc::Interface
+                MaterialDesc::Diffuse { .. }
+                    | MaterialDesc::Interface
+                    | MaterialDesc::Textured(TexturedMaterialDesc::Diffuse { .. })
             );
             if !exact && !approximated[shape.material as usize] {
                 approximated[shape.material as usize] = true;

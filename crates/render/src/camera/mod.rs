@@ -4,10 +4,12 @@
 
 pub mod projective;
 pub mod realistic;
+pub mod spread;
 
 use glam::Vec2;
 
 pub use projective::{Projection, ProjectiveCamera};
+pub use spread::RaySpread;
 
 use crate::geometry::Ray;
 

@@ -106,9 +106,11 @@ pub fn radiance(
     let mut prev_ctx = LightSampleContext::at_point(ray.o);
     let mut rays = 0u32;
     let mut depth = 0u32;
+    // Distance along the path from the camera, for texture footprints.
+    let mut travelled = 0.0f32;
     loop {
         rays += 1;
-        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+        let Some(mut hit) = world.intersect(&ray, f32::INFINITY) else {
             for (i, light) in world.lights.iter().enumerate() {
                 let le = light.environment(ray.d);
                 if le.is_black() {
@@ -125,6 +127,8 @@ pub fn radiance(
             }
             break;
         };
+        travelled += hit.t * ray.d.length();
+        world.add_footprint(&mut hit, ray.d, travelled);
         let wo_world = -ray.d.normalize();
         if hit.light != NO_LIGHT {
             let Light::Area(area) = &world.lights[hit.light as usize] else {

@@ -152,6 +152,13 @@ impl Material {
             // The world resolves a mix to one of its two materials per hit; its own
             // table entry is never shaded.
             MaterialDesc::Mix { .. } => Material::Interface,
+            // Without the textures: each texture read as a mid value (the world
+            // evaluates them per hit instead).
+            MaterialDesc::Textured(t) => crate::texture::concrete_material(
+                t,
+                |p| p.constant().unwrap_or(0.0),
+                |p| p.constant().unwrap_or(Rgb::splat(0.5)),
+            ),
         }
     }
 

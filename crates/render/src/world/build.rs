@@ -7,6 +7,7 @@ use glam::{Mat3, Vec2, Vec3};
 
 use super::shapes::{BilinearPrim, Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr};
 use super::{MAX_MIX_DEPTH, MaterialEntry, NO_LIGHT, World};
+use crate::camera::RaySpread;
 use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
@@ -15,11 +16,31 @@ use crate::light::{
     LightSampler, LightShape, SceneSphere, rotation_of,
 };
 use crate::material::Material;
+use crate::texture::{TextureSet, concrete_material};
 use radiant_math::Transform;
 use radiant_scene::{
     AreaLightDesc, EnvironmentImage, FileLoc, Geometry, LightDesc, MaterialDesc, SceneDesc,
-    SceneError, ShapeDesc, Warning,
+    SceneError, ShapeDesc, TexturedMaterialDesc, TexturedParam, Warning,
 };
+
+/// Point lookups per axis over the (u, v) square for a textured material's mean.
+const AVERAGE_GRID: u32 = 8;
+
+/// A textured material with each texture replaced by its mean over (u, v).
+fn representative(desc: &TexturedMaterialDesc, textures: &TextureSet) -> Material {
+    concrete_material(
+        desc,
+        |p| match p {
+            TexturedParam::Constant(v) => v,
+            TexturedParam::Texture(id) => {
+                textures
+                    .uv_average(TexturedParam::Texture(id), AVERAGE_GRID)
+                    .r
+            }
+        },
+        |p| textures.uv_average(p, AVERAGE_GRID),
+    )
+}
 
 /// Errors building the world are scene errors: they name the shape's location.
 pub type BuildError = SceneError;
@@ -30,7 +51,16 @@ impl World {
     pub fn build(desc: &SceneDesc) -> Result<(World, Vec<Warning>), BuildError> {
         check_capacity(desc)?;
         let mut warnings = Vec::new();
-        let materials = material_table(&desc.materials)?;
+        let textures = TextureSet::build(desc)?;
+        let textured: Vec<Option<TexturedMaterialDesc>> = desc
+            .materials
+            .iter()
+            .map(|m| match m {
+                MaterialDesc::Textured(t) => Some(t.clone()),
+                _ => None,
+            })
+            .collect();
+        let materials = material_table(&desc.materials, &textures)?;
         let mut lights = Vec::new();
 
         let mut prototypes = Vec::with_capacity(desc.objects.len());
@@ -77,6 +107,9 @@ impl World {
             geometry: top,
             prototypes,
             materials,
+            textured,
+            textures,
+            ray_spread: RaySpread::NONE,
             lights,
             light_sampler,
             bounds,
@@ -246,8 +279,12 @@ fn is_similarity(xf: &Transform) -> bool {
 }
 
 /// The world's material table, entry for entry the description's: BSDFs, and mixes
-/// that refer to other entries (checked to be in range and free of cycles).
-fn material_table(descs: &[MaterialDesc]) -> Result<Vec<MaterialEntry>, BuildError> {
+/// that refer to other entries (checked to be in range and free of cycles); a textured
+/// material at its textures' means (its textures are evaluated per hit).
+fn material_table(
+    descs: &[MaterialDesc],
+    textures: &TextureSet,
+) -> Result<Vec<MaterialEntry>, BuildError> {
     let table: Vec<MaterialEntry> = descs
         .iter()
         .map(|d| match d {
@@ -255,6 +292,7 @@ fn material_table(descs: &[MaterialDesc]) -> Result<Vec<MaterialEntry>, BuildErr
                 materials: *materials,
                 amount: *amount,
             },
+            MaterialDesc::Textured(t) => MaterialEntry::Bsdf(representative(t, textures)),
             d => MaterialEntry::Bsdf(Material::from_desc(d)),
         })
         .collect();

@@ -12,12 +12,15 @@ use glam::{Vec2, Vec3};
 pub use build::BuildError;
 pub use shapes::ShapeSet;
 
+use crate::camera::RaySpread;
 use crate::geometry::{Aabb, Ray, SurfacePoint};
 use crate::light::{Light, LightHit, LightSampleContext, LightSampler};
 use crate::material::Material;
+use crate::texture::{TextureEvalContext, TextureSet};
 use radiant_math::Frame;
 use radiant_math::color::Rgb;
 use radiant_math::hash::{hash_u64s, u32_to_unit_f32};
+use radiant_scene::TexturedMaterialDesc;
 
 /// No light attached (in per-primitive light indices).
 pub const NO_LIGHT: u32 = u32::MAX;
@@ -36,10 +39,15 @@ pub struct SurfaceHit {
     /// Unit shading normal, on the same side as `ng`.
     pub ns: Vec3,
     pub uv: Vec2,
-    /// ∂p/∂u in render space (pbrt's convention per shape): the first tangent axis of
-    /// anisotropic BSDFs. Not normalised; may be zero where the parameterisation is
-    /// degenerate.
+    /// ∂p/∂u and ∂p/∂v in render space (pbrt's convention per shape); ∂p/∂u is the
+    /// first tangent axis of anisotropic BSDFs. Not normalised; zero where the shape
+    /// does not provide them (then uv-mapped textures are point-sampled).
     pub dpdu: Vec3,
+    pub dpdv: Vec3,
+    /// How `p` moves from one pixel to the next (x, y): the footprint that texture
+    /// filters use. Zero until [`World::add_footprint`] sets it.
+    pub dpdx: Vec3,
+    pub dpdy: Vec3,
     pub material: u32,
     /// Index of the area light of this primitive, or [`NO_LIGHT`].
     pub light: u32,
@@ -102,8 +110,15 @@ pub struct World {
     pub(crate) geometry: ShapeSet,
     /// Object prototypes for instancing (in instance space).
     pub(crate) prototypes: Vec<ShapeSet>,
-    /// Resolve an entry at a hit with [`World::material_at`].
+    /// Resolve an entry at a hit with [`World::material_at`]. A textured material's
+    /// entry holds its value at the textures' (u, v) averages (what queries about the
+    /// kind of surface see).
     pub materials: Vec<MaterialEntry>,
+    /// The textured description of each material id that has one.
+    pub(crate) textured: Vec<Option<TexturedMaterialDesc>>,
+    pub textures: TextureSet,
+    /// The camera's pixel footprint along paths, for texture filtering.
+    pub ray_spread: RaySpread,
     pub lights: Vec<Light>,
     /// Chooses among `lights` for next-event estimation and photon emission.
     pub light_sampler: LightSampler,
@@ -132,21 +147,41 @@ impl World {
     /// table entry itself, or for a mix one of its materials (nested mixes resolved in
     /// turn). Deterministic: the choice is a pure function of the point, the direction
     /// and the entries, as in pbrt-v4's `MixMaterial::ChooseMaterial`.
+    /// A textured material's textures are evaluated at the hit with its footprint.
     pub fn material_at(&self, hit: &SurfaceHit, wo_world: Vec3) -> Material {
-        self.resolve_material(hit.material, hit.p, wo_world)
+        let index = self.resolve_index(hit.material, hit.p, wo_world);
+        match self.textured.get(index as usize) {
+            Some(Some(desc)) => self
+                .textures
+                .material(desc, &TextureEvalContext::from_hit(hit)),
+            _ => self.entry_material(index),
+        }
     }
 
-    /// [`material_at`](Self::material_at) for an entry, point and direction.
-    pub fn resolve_material(&self, mut index: u32, p: Vec3, wo_world: Vec3) -> Material {
+    /// [`material_at`](Self::material_at) for an entry, point and direction, without
+    /// textures (a textured material at its textures' averages).
+    pub fn resolve_material(&self, index: u32, p: Vec3, wo_world: Vec3) -> Material {
+        self.entry_material(self.resolve_index(index, p, wo_world))
+    }
+
+    /// The entry a mix chain starting at `index` chooses at `p` seen from `wo_world`.
+    fn resolve_index(&self, mut index: u32, p: Vec3, wo_world: Vec3) -> u32 {
         for _ in 0..=MAX_MIX_DEPTH {
             match self.materials[index as usize] {
-                MaterialEntry::Bsdf(m) => return m,
+                MaterialEntry::Bsdf(_) => return index,
                 MaterialEntry::Mix { materials, amount } => {
                     index = choose_mixed(materials, amount, p, wo_world);
                 }
             }
         }
         unreachable!("the world builder refuses cyclic mixes")
+    }
+
+    fn entry_material(&self, index: u32) -> Material {
+        match self.materials[index as usize] {
+            MaterialEntry::Bsdf(m) => m,
+            MaterialEntry::Mix { .. } => unreachable!("resolved above"),
+        }
     }
 
     /// Every material an entry can resolve to, with its probability (mixes expanded).
@@ -196,6 +231,19 @@ impl World {
             Frame::from_normal_tangent(hit.ns, hit.dpdu)
         } else {
             Frame::from_normal(hit.ns)
+        }
+    }
+
+    /// True when some material is textured: only then do integrators need footprints.
+    pub fn has_textures(&self) -> bool {
+        self.textured.iter().any(Option::is_some)
+    }
+
+    /// Sets the hit's footprint for a ray of direction `d` that has travelled
+    /// `distance` from the camera (only when textures need it).
+    pub fn add_footprint(&self, hit: &mut SurfaceHit, d: Vec3, distance: f32) {
+        if self.ray_spread != RaySpread::NONE && self.has_textures() {
+            (hit.dpdx, hit.dpdy) = self.ray_spread.differentials(d, distance, hit.ng);
         }
     }
 

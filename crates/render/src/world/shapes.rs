@@ -331,6 +331,7 @@ impl ShapeSet {
                 hit.ng = to_render.normal(hit.ng).normalize();
                 hit.ns = to_render.normal(hit.ns).normalize();
                 hit.dpdu = to_render.vector(hit.dpdu);
+                hit.dpdv = to_render.vector(hit.dpdv);
                 Some(hit)
             }
         }
@@ -380,6 +381,7 @@ impl ShapeSet {
             } => {
                 let b = &self.bilinears[i as usize];
                 let n = n_obj * b.orientation;
+                let tangents = b.patch.tangents(uv);
                 SurfaceHit {
                     t,
                     p: p_obj,
@@ -387,7 +389,10 @@ impl ShapeSet {
                     ng: n,
                     ns: n,
                     uv,
-                    dpdu: b.patch.tangents(uv).0,
+                    dpdu: tangents.0,
+                    dpdv: tangents.1,
+                    dpdx: Vec3::ZERO,
+                    dpdy: Vec3::ZERO,
                     material: b.material,
                     light: b.light,
                 }
@@ -439,6 +444,9 @@ impl ShapeSet {
                     ns: n,
                     uv,
                     dpdu,
+                    dpdv: Vec3::ZERO,
+                    dpdx: Vec3::ZERO,
+                    dpdy: Vec3::ZERO,
                     material,
                     light,
                 }
@@ -483,6 +491,7 @@ impl ShapeSet {
             None => [Vec2::ZERO, Vec2::X, Vec2::ONE],
         };
         let uv = b[0] * tuv[0] + b[1] * tuv[1] + b[2] * tuv[2];
+        let (dpdu, dpdv) = triangle_tangents([p0, p1, p2], tuv);
         SurfaceHit {
             t,
             p,
@@ -490,25 +499,33 @@ impl ShapeSet {
             ng,
             ns,
             uv,
-            dpdu: triangle_dpdu([p0, p1, p2], tuv),
+            dpdu,
+            dpdv,
+            dpdx: Vec3::ZERO,
+            dpdy: Vec3::ZERO,
             material: attr.material,
             light: attr.light,
         }
     }
 }
 
-/// ∂p/∂u of a triangle from its vertex uvs (the inverse of the 2×2 uv Jacobian, as in
+/// ∂p/∂u and ∂p/∂v of a triangle from its vertex uvs (the inverse of the 2×2 uv Jacobian, as in
 /// pbrt-v4's triangle); zero when the uvs are degenerate, so that the shading frame
 /// falls back to an arbitrary tangent.
-fn triangle_dpdu(p: [Vec3; 3], uv: [Vec2; 3]) -> Vec3 {
+fn triangle_tangents(p: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
     let (duv02, duv12) = (uv[0] - uv[2], uv[1] - uv[2]);
     let (dp02, dp12) = (p[0] - p[2], p[1] - p[2]);
     let det = duv02.x * duv12.y - duv02.y * duv12.x;
     if det.abs() < 1e-9 {
-        return Vec3::ZERO;
+        return (Vec3::ZERO, Vec3::ZERO);
     }
     let dpdu = (duv12.y * dp02 - duv02.y * dp12) / det;
-    if dpdu.is_finite() { dpdu } else { Vec3::ZERO }
+    let dpdv = (duv02.x * dp12 - duv12.x * dp02) / det;
+    if dpdu.is_finite() && dpdv.is_finite() {
+        (dpdu, dpdv)
+    } else {
+        (Vec3::ZERO, Vec3::ZERO)
+    }
 }
 
 /// The ray in a shape's object space. The direction is not renormalised, so hit

@@ -1,6 +1,6 @@
 //! `Material`, `MakeNamedMaterial`, `NamedMaterial` and `Texture`.
 //!
-//! - `"diffuse"`: `reflectance` (spectrum, default 0.5).
+//! - `"diffuse"`: `reflectance` (spectrum or spectrum texture, default 0.5).
 //! - `"dielectric"`: `eta` (float or spectrum; default 1.5; named glasses become their
 //!   d-line index).
 //! - `"conductor"`: `reflectance` (an artist's mirror colour), else `eta` and `k`
@@ -16,8 +16,8 @@
 //!   `remaproughness` (default true) maps each to the Trowbridge–Reitz alpha as
 //!   alpha = sqrt(roughness); with it false the values are alphas already. Any
 //!   non-zero alpha gives `RoughDielectric` / `RoughConductor` (the renderer keeps
-//!   alphas below its smooth threshold a delta BSDF). Textured roughness is reported
-//!   and read as 0.
+//!   alphas below its smooth threshold a delta BSDF). Roughness may be a float
+//!   texture.
 //! - `"coateddiffuse"`: a dielectric coat over a Lambertian base: `reflectance`
 //!   (0.5), the coat's `roughness` / `uroughness` / `vroughness` (0) and
 //!   `remaproughness` as above, `eta` (1.5, as for `dielectric`), and the slab between:
@@ -28,8 +28,10 @@
 //!   `maxdepth`, `nsamples` without prefix) over a conductor read as `conductor`
 //!   reads it, its parameters prefixed `conductor.` (`conductor.eta` / `conductor.k`,
 //!   default copper, or `reflectance`; `conductor.roughness`, ...).
-//! - Textured floats of the layered materials (`thickness`, `g`) are reported and
-//!   read as their defaults.
+//! - Textured floats of the layered materials (`thickness`, `g`, roughness) are
+//!   reported and read as their defaults.
+//! - A material with a texture-valued parameter becomes [`MaterialDesc::Textured`];
+//!   one whose parameters are all constant keeps its plain variant.
 //! - Other material types render as diffuse 0.5 with a warning.
 
 use super::Parser;
@@ -40,6 +42,7 @@ use crate::error::{FileLoc, SceneError};
 use crate::named_spectra::{glass_eta, metal_spectrum};
 use crate::params::{ParamSet, ParamValue};
 use crate::spectrum::{interpolate, pairs_from_flat};
+use crate::texture::{FloatParam, RoughnessDesc, TexturedMaterialDesc, TexturedParam};
 use radiant_math::color::Rgb;
 
 /// pbrt-v4's material types that radiant replaces by diffuse 0.5.
@@ -110,20 +113,6 @@ impl Parser {
         }
     }
 
-    /// `Texture "name" "type" "class" params`: read past with one warning.
-    pub(super) fn texture(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
-        let (name, _) = self.string_arg("Texture")?;
-        self.string_arg("Texture")?;
-        let (class, _) = self.string_arg("Texture")?;
-        self.param_list()?.mark_all_used();
-        self.require_world("Texture", loc)?;
-        self.warn(
-            loc,
-            format!("Texture \"{name}\" (\"{class}\"): textures are not supported; materials using it fall back to constants"),
-        );
-        Ok(())
-    }
-
     fn push_material(&mut self, m: MaterialDesc) -> MaterialId {
         self.materials.push(m);
         (self.materials.len() - 1) as MaterialId
@@ -163,37 +152,51 @@ impl Parser {
             }
         }
         Ok(match ty {
-            "diffuse" => MaterialDesc::Diffuse {
-                reflectance: self.spectrum_or(
-                    ps,
-                    "reflectance",
-                    SpectrumUse::Albedo,
-                    Rgb::splat(0.5),
-                    owner,
-                )?,
+            "diffuse" => match self.spectrum_texture_param(
+                ps,
+                "reflectance",
+                SpectrumUse::Albedo,
+                Rgb::splat(0.5),
+            )? {
+                TexturedParam::Constant(reflectance) => MaterialDesc::Diffuse { reflectance },
+                reflectance => {
+                    MaterialDesc::Textured(TexturedMaterialDesc::Diffuse { reflectance })
+                }
             },
             "dielectric" => {
-                let alpha = self.microfacet_alpha(ps, "", owner)?;
+                let alpha = self.microfacet_alpha(ps, "")?;
                 let eta = self.dielectric_eta(ps, "eta", owner)?;
                 match alpha {
-                    None => MaterialDesc::Dielectric { eta },
-                    Some((alpha_u, alpha_v)) => MaterialDesc::RoughDielectric {
+                    Alpha::Smooth => MaterialDesc::Dielectric { eta },
+                    Alpha::Constant(alpha_u, alpha_v) => MaterialDesc::RoughDielectric {
                         eta,
                         alpha_u,
                         alpha_v,
                     },
+                    Alpha::Textured(roughness) => {
+                        MaterialDesc::Textured(TexturedMaterialDesc::RoughDielectric {
+                            eta,
+                            roughness,
+                        })
+                    }
                 }
             }
             "conductor" => {
-                let alpha = self.microfacet_alpha(ps, "", owner)?;
+                let alpha = self.microfacet_alpha(ps, "")?;
                 let conductor = self.conductor_desc(ps, "", owner)?;
                 match alpha {
-                    None => MaterialDesc::Conductor(conductor),
-                    Some((alpha_u, alpha_v)) => MaterialDesc::RoughConductor {
+                    Alpha::Smooth => MaterialDesc::Conductor(conductor),
+                    Alpha::Constant(alpha_u, alpha_v) => MaterialDesc::RoughConductor {
                         conductor,
                         alpha_u,
                         alpha_v,
                     },
+                    Alpha::Textured(roughness) => {
+                        MaterialDesc::Textured(TexturedMaterialDesc::RoughConductor {
+                            conductor,
+                            roughness,
+                        })
+                    }
                 }
             }
             "coateddiffuse" => MaterialDesc::CoatedDiffuse {
@@ -208,9 +211,7 @@ impl Parser {
             },
             "coatedconductor" => {
                 let coat = self.coat_desc(ps, "interface.", loc, owner)?;
-                let (alpha_u, alpha_v) = self
-                    .microfacet_alpha(ps, "conductor.", owner)?
-                    .unwrap_or((0.0, 0.0));
+                let (alpha_u, alpha_v) = self.constant_alpha(ps, "conductor.", owner)?;
                 let conductor = self.conductor_desc(ps, "conductor.", owner)?;
                 MaterialDesc::CoatedConductor {
                     conductor,
@@ -348,9 +349,7 @@ impl Parser {
         loc: &FileLoc,
         owner: &str,
     ) -> Result<CoatDesc, SceneError> {
-        let (alpha_u, alpha_v) = self
-            .microfacet_alpha(ps, prefix, owner)?
-            .unwrap_or((0.0, 0.0));
+        let (alpha_u, alpha_v) = self.constant_alpha(ps, prefix, owner)?;
         let eta = self.dielectric_eta(ps, &format!("{prefix}eta"), owner)?;
         let thickness = self.layer_float(ps, "thickness", 0.01, owner)?;
         if thickness <= 0.0 {
@@ -416,60 +415,68 @@ impl Parser {
         ps.finite_float(name, default)
     }
 
-    /// The microfacet alphas (u, v) of a dielectric or conductor, or `None` when both
-    /// are zero (a smooth surface). pbrt-v4: `roughness` stands for `uroughness` and
+    /// The microfacet alphas (u, v) of a dielectric or conductor: smooth when both
+    /// are the constant zero. pbrt-v4: `roughness` stands for `uroughness` and
     /// `vroughness` where they are absent; `remaproughness` (default true) turns each
-    /// roughness into alpha = sqrt(roughness). Each name but `remaproughness` carries
-    /// `prefix` (`interface.`, `conductor.` for the layered materials).
-    fn microfacet_alpha(
+    /// roughness into alpha = sqrt(roughness). Any textured roughness keeps all three
+    /// as written, for the renderer to remap per hit. Each name but `remaproughness`
+    /// carries `prefix` (`interface.`, `conductor.` for the layered materials).
+    fn microfacet_alpha(&mut self, ps: &ParamSet, prefix: &str) -> Result<Alpha, SceneError> {
+        let remap = ps.bool("remaproughness", true)?;
+        let read = |p: &mut Parser, name: &str| -> Result<Option<FloatParam>, SceneError> {
+            let name = &format!("{prefix}{name}");
+            if !ps.has(name) {
+                return Ok(None);
+            }
+            let r = p.float_texture_param(ps, name, 0.0)?;
+            if let TexturedParam::Constant(v) = r
+                && v < 0.0
+            {
+                return Err(SceneError::at(
+                    &ps.lookup(name).expect("present").loc,
+                    format!("\"{name}\" {v} must be finite and >= 0"),
+                ));
+            }
+            Ok(Some(r))
+        };
+        let both = read(self, "roughness")?.unwrap_or(TexturedParam::Constant(0.0));
+        let u = read(self, "uroughness")?.unwrap_or(both);
+        let v = read(self, "vroughness")?.unwrap_or(both);
+        let roughness = RoughnessDesc { u, v, remap };
+        let (alpha_u, alpha_v) = match (u, v) {
+            (TexturedParam::Constant(u), TexturedParam::Constant(v)) => roughness.alphas(u, v),
+            _ => return Ok(Alpha::Textured(roughness)),
+        };
+        if alpha_u == 0.0 && alpha_v == 0.0 {
+            return Ok(Alpha::Smooth);
+        }
+        Ok(Alpha::Constant(alpha_u, alpha_v))
+    }
+
+    /// [`microfacet_alpha`](Self::microfacet_alpha) for the layered materials, whose
+    /// roughness must be constant: a textured one is reported and read as 0.
+    fn constant_alpha(
         &mut self,
         ps: &ParamSet,
         prefix: &str,
         owner: &str,
-    ) -> Result<Option<(f32, f32)>, SceneError> {
-        let remap = ps.bool("remaproughness", true)?;
-        let mut read = |name: &str| -> Result<Option<f32>, SceneError> {
-            let name = &format!("{prefix}{name}");
-            let Some(p) = ps.lookup(name) else {
-                return Ok(None);
-            };
-            match &p.value {
-                ParamValue::Float(v) if v.len() == 1 => {
-                    if v[0].is_finite() && v[0] >= 0.0 {
-                        Ok(Some(v[0]))
-                    } else {
-                        Err(SceneError::at(
-                            &p.loc,
-                            format!("\"{name}\" {} must be finite and >= 0", v[0]),
-                        ))
-                    }
-                }
-                ParamValue::Texture(_) => {
-                    let at = p.loc.clone();
-                    self.warn(
-                        &at,
-                        format!("{owner}: textured \"{name}\" is not supported; read as 0"),
-                    );
-                    Ok(Some(0.0))
-                }
-                other => Err(SceneError::at(
-                    &p.loc,
-                    format!(
-                        "parameter \"{name}\" has type \"{}\" or the wrong count; expected one float",
-                        other.type_name()
-                    ),
-                )),
+    ) -> Result<(f32, f32), SceneError> {
+        Ok(match self.microfacet_alpha(ps, prefix)? {
+            Alpha::Smooth => (0.0, 0.0),
+            Alpha::Constant(u, v) => (u, v),
+            Alpha::Textured(_) => {
+                let at = ["roughness", "uroughness", "vroughness"]
+                    .iter()
+                    .find_map(|n| ps.lookup(&format!("{prefix}{n}")))
+                    .map(|p| p.loc.clone())
+                    .expect("a textured roughness was read");
+                self.warn(
+                    &at,
+                    format!("{owner}: textured \"{prefix}roughness\" is not supported; read as 0"),
+                );
+                (0.0, 0.0)
             }
-        };
-        let both = read("roughness")?.unwrap_or(0.0);
-        let u = read("uroughness")?.unwrap_or(both);
-        let v = read("vroughness")?.unwrap_or(both);
-        let to_alpha = |r: f32| if remap { r.sqrt() } else { r };
-        let (alpha_u, alpha_v) = (to_alpha(u), to_alpha(v));
-        if alpha_u == 0.0 && alpha_v == 0.0 {
-            return Ok(None);
-        }
-        Ok(Some((alpha_u, alpha_v)))
+        })
     }
 
     fn dielectric_eta(
@@ -534,4 +541,12 @@ impl Parser {
         }
         Ok(eta)
     }
+}
+
+/// A microfacet material's roughness as read.
+enum Alpha {
+    Smooth,
+    /// Alphas (u, v), already remapped.
+    Constant(f32, f32),
+    Textured(RoughnessDesc),
 }

@@ -19,6 +19,7 @@ mod param_list;
 mod shapes;
 mod spectrum_param;
 mod state;
+mod textures;
 mod transforms;
 
 use std::collections::{HashMap, HashSet};
@@ -30,6 +31,7 @@ use glam::Vec2;
 use super::desc::*;
 use super::error::{FileLoc, SceneError, Warning};
 use super::params::{ParamSet, ParamValue};
+use super::texture::{TextureDesc, TextureId, TextureType};
 use super::token::{Lexer, Token, TokenKind};
 use radiant_math::Transform;
 use state::{GraphicsState, SavedState};
@@ -165,6 +167,9 @@ pub(super) struct Parser {
     filter: Option<FilterDesc>,
     integrator: Option<IntegratorDesc>,
     materials: Vec<MaterialDesc>,
+    textures: Vec<TextureDesc>,
+    /// Texture names per namespace (pbrt-v4 keeps float and spectrum names apart).
+    named_textures: HashMap<(TextureType, String), TextureId>,
     shapes: Vec<ShapeDesc>,
     objects: Vec<ObjectDesc>,
     lights: Vec<LightDesc>,
@@ -203,6 +208,8 @@ impl Parser {
             filter: None,
             integrator: None,
             materials: Vec::new(),
+            textures: Vec::new(),
+            named_textures: HashMap::new(),
             shapes: Vec::new(),
             objects: Vec::new(),
             lights: Vec::new(),
@@ -532,6 +539,7 @@ impl Parser {
                 loc,
             }),
             materials: self.materials,
+            textures: self.textures,
             shapes: self.shapes,
             objects: self.objects,
             instances,

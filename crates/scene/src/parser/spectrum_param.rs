@@ -23,7 +23,7 @@ pub(super) enum SpectrumUse {
 #[derive(Clone, Debug, PartialEq)]
 pub(super) enum SpectrumValue {
     Rgb(Rgb),
-    /// A `texture` parameter: radiant has no textures, the caller falls back.
+    /// A `texture` parameter: the texture's name, for the caller to resolve.
     Texture(String),
 }
 
@@ -197,7 +197,8 @@ impl Parser {
         self.sampled_to_rgb(&pairs, usage, loc)
     }
 
-    /// A spectrum with a default; textures fall back to the default with a warning.
+    /// A spectrum with a default, for parameters that take no texture: a texture falls
+    /// back to the default with a warning.
     pub(super) fn spectrum_or(
         &mut self,
         ps: &ParamSet,
@@ -213,7 +214,7 @@ impl Parser {
                 self.warn(
                     &loc,
                     format!(
-                        "{owner}: textures are not supported; \"texture {name}\" (\"{t}\") is replaced by ({}, {}, {})",
+                        "{owner}: a texture for \"{name}\" is not supported here; \"{t}\" is replaced by ({}, {}, {})",
                         default.r, default.g, default.b
                     ),
                 );

@@ -76,11 +76,12 @@ pub fn radiance(
     let mut travelled = 0.0f32;
     for depth in 0..=settings.max_depth {
         rays += 1;
-        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+        let Some(mut hit) = world.intersect(&ray, f32::INFINITY) else {
             l += beta * environment(world, ray.d);
             break;
         };
         travelled += hit.t * ray.d.length();
+        world.add_footprint(&mut hit, ray.d, travelled);
         let wo_world = -ray.d.normalize();
         let emitted = surface_emission(world, &hit, wo_world);
         let material = world.material_at(&hit, wo_world);

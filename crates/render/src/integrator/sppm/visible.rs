@@ -77,12 +77,15 @@ pub fn camera_sample(
     let mut ray = cr.ray;
     // The sensor is the film's; the camera path starts with the camera's weight.
     let mut beta = Rgb::splat(cr.weight * cs.filter_weight);
+    let mut travelled = 0.0f32;
     for depth in 0..=max_depth {
         out.rays += 1;
-        let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
+        let Some(mut hit) = world.intersect(&ray, f32::INFINITY) else {
             out.ld += beta * environment(world, ray.d);
             break;
         };
+        travelled += hit.t * ray.d.length();
+        world.add_footprint(&mut hit, ray.d, travelled);
         let wo_world = -ray.d.normalize();
         // Only specular vertices precede this one: emission always counts.
         out.ld += beta * surface_emission(world, &hit, wo_world);
