@@ -7,5 +7,6 @@
 mod common;
 mod maps;
 mod photonmap;
+mod rough_glass;
 mod scenes;
 mod sppm;
