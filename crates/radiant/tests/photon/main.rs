@@ -1,7 +1,8 @@
 //! Photon mapping and stochastic progressive photon mapping: stored energy,
 //! projection maps, the furnace, the cornell-caustics reference, the spot-lit caustic
 //! the path tracer cannot render, visualisations, snapshots, cancellation,
-//! determinism and parameters.
+//! determinism and parameters; rough glass against the path tracer and the power
+//! its photons carry on.
 
 #[path = "../common/mod.rs"]
 mod common;
