@@ -273,8 +273,14 @@ fn build_range<T: KdPoint + Send>(
 /// takes a good part of a second; a large buffer is freed on a thread of its own so
 /// that the stopping caller does not wait for it.
 pub fn release<T: Send + 'static>(buffer: Vec<T>) {
-    if buffer.len() * std::mem::size_of::<T>() >= 64 << 20 {
-        std::thread::spawn(move || drop(buffer));
+    let bytes = buffer.len() * std::mem::size_of::<T>();
+    release_sized(buffer, bytes);
+}
+
+/// [`release`] for any owner of `bytes` of heap memory.
+pub fn release_sized<B: Send + 'static>(owner: B, bytes: usize) {
+    if bytes >= 64 << 20 {
+        std::thread::spawn(move || drop(owner));
     }
 }
 
