@@ -38,6 +38,17 @@ pub enum ImageError {
         message: String,
     },
 
+    /// The image declares more pixels than radiant reads (a damaged or hostile header
+    /// would otherwise make the reader allocate gigabytes before failing).
+    #[error("{path}: {width}x{height} pixels ({what}) is more than the {limit} pixels radiant reads", path = path.display())]
+    TooLarge {
+        path: PathBuf,
+        what: &'static str,
+        width: u64,
+        height: u64,
+        limit: u64,
+    },
+
     /// The file name does not end in a known image extension.
     #[error("{path}: unknown image format (expected .exr, .pfm or .png)", path = path.display())]
     UnknownFormat { path: PathBuf },

@@ -103,6 +103,10 @@ pub fn write_exr(
     })
 }
 
+/// The most samples (pixels × channels, all layers together) an EXR may declare:
+/// 2^30, 4 GiB of f32 — far beyond any render or environment map radiant reads.
+pub const MAX_READ_SAMPLES: u64 = 1 << 30;
+
 /// Reads the first layer of an EXR that has R, G and B channels (bare or as `<layer>.R`,
 /// preferring the shortest name, as `compare.py` does) or else a Y channel (grey).
 /// Samples may be f16, f32 or u32; they are converted to f32.
@@ -114,6 +118,25 @@ pub fn read_exr(path: impl AsRef<Path>) -> Result<Image, ImageError> {
     };
     // Open the file ourselves so that a missing file reads as an I/O error, not an EXR one.
     let reader = std::fs::File::open(path).map_err(|e| ImageError::io(path, e))?;
+    // The reader allocates every layer's samples from the header's sizes before reading
+    // them: check those first.
+    let meta = x::MetaData::read_from_file(path, false).map_err(exr_error)?;
+    let mut samples = 0u64;
+    for header in meta.headers.iter() {
+        let size = header.layer_size;
+        let (w, h) = (size.width() as u64, size.height() as u64);
+        let channels = header.channels.list.len() as u64;
+        samples = samples.saturating_add(w.saturating_mul(h).saturating_mul(channels));
+        if samples > MAX_READ_SAMPLES {
+            return Err(ImageError::TooLarge {
+                path: path.to_path_buf(),
+                what: "EXR data window",
+                width: w,
+                height: h,
+                limit: MAX_READ_SAMPLES / channels.max(1),
+            });
+        }
+    }
     let file = x::read()
         .no_deep_data()
         .largest_resolution_level()

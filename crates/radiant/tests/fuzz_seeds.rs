@@ -79,8 +79,8 @@ fn lens_seeds_build_or_fail_located() {
     }
 }
 
-/// Image seeds (PFM, EXR, PNG) decode; the same bytes cut to one byte or to half fail
-/// with an error.
+/// Image seeds (PFM, EXR, PNG) decode, and the same bytes cut to one byte or to half
+/// fail with an error; `bad-` seeds (what the fuzzer found) fail with an error.
 #[test]
 fn image_seeds_decode_and_truncations_fail() {
     let dir = radiant_testkit::output_dir("fuzz-seeds");
@@ -92,6 +92,12 @@ fn image_seeds_decode_and_truncations_fail() {
             Some("png") => radiant::image::png::read_png(p).map(|_| ()),
             _ => radiant::image::pfm::read_pfm(p).map(|_| ()),
         };
+        if name.starts_with("bad-") {
+            // Inputs the fuzzer found: each must be refused with an error naming the file.
+            let e = read(&path).expect_err(&name).to_string();
+            assert!(e.contains(&name), "{name}: {e}");
+            continue;
+        }
         read(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
         // (A PNG cut inside its final IEND chunk still holds the whole image.)
         for cut in [1, bytes.len() / 2] {
