@@ -14,7 +14,7 @@ use ::exr::meta::attribute::{AttributeValue, Chromaticities, Text};
 use ::exr::prelude as x;
 use ::exr::prelude::{ReadChannels, ReadLayers, WritableImage};
 
-use super::{Image, ImageError, ImageMeta};
+use super::{Image, ImageError, ImageMeta, MAX_READ_SAMPLES};
 
 /// EXR attribute holding the samples per pixel of a render (type `int`).
 pub const ATTR_SAMPLES_PER_PIXEL: &str = "samplesPerPixel";
@@ -102,10 +102,6 @@ pub fn write_exr(
             })
     })
 }
-
-/// The most samples (pixels × channels, all layers together) an EXR may declare:
-/// 2^30, 4 GiB of f32 — far beyond any render or environment map radiant reads.
-pub const MAX_READ_SAMPLES: u64 = 1 << 30;
 
 /// Reads the first layer of an EXR that has R, G and B channels (bare or as `<layer>.R`,
 /// preferring the shortest name, as `compare.py` does) or else a Y channel (grey).

@@ -22,6 +22,11 @@ use std::path::Path;
 use radiant_math::color::Rgb;
 
 pub use error::ImageError;
+
+/// The most samples (pixels × channels, all layers together) an image file may declare:
+/// 2^30, 4 GiB of f32 — far beyond any render, texture or environment map radiant
+/// reads. Readers check headers against it before allocating.
+pub const MAX_READ_SAMPLES: u64 = 1 << 30;
 pub use film::{Film, FilmPixel, NonFinite, Sensor};
 pub use filter::{Filter, FilterSample};
 pub use metrics::{Metrics, compare};

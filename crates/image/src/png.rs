@@ -104,6 +104,18 @@ pub fn read_png(path: impl AsRef<Path>) -> Result<Image, ImageError> {
     // Expand palettes and low bit depths to 8 bit; 16-bit stays 16-bit.
     decoder.set_transformations(::png::Transformations::EXPAND);
     let mut reader = decoder.read_info().map_err(png_error)?;
+    // The frame buffer is allocated from the header's size before any pixel is read:
+    // check it first (a damaged header must not ask for gigabytes).
+    let (w, h) = (reader.info().width as u64, reader.info().height as u64);
+    if w.saturating_mul(h).saturating_mul(4) > crate::MAX_READ_SAMPLES {
+        return Err(ImageError::TooLarge {
+            path: path.to_path_buf(),
+            what: "PNG",
+            width: w,
+            height: h,
+            limit: crate::MAX_READ_SAMPLES / 4,
+        });
+    }
     let size = reader.output_buffer_size().ok_or_else(|| ImageError::Png {
         path: path.to_path_buf(),
         message: "image too large".to_string(),
