@@ -102,22 +102,7 @@ fn sum(points: &[DVec3], ids: &[u32]) -> DVec3 {
 fn refine(points: &[DVec3], indices: &[u32]) -> (Vec<DVec3>, Vec<u32>) {
     let edges = Edges::of(indices);
     let rings = edges.rings(points.len());
-    let mut out: Vec<DVec3> = points
-        .iter()
-        .enumerate()
-        .map(|(v, &p)| {
-            let boundary = &rings.boundary[v];
-            let ring = &rings.neighbours[v];
-            match boundary.len() {
-                0 if ring.len() >= 3 => {
-                    let b = beta(ring.len());
-                    (1.0 - ring.len() as f64 * b) * p + b * sum(points, ring)
-                }
-                2 => 0.75 * p + 0.125 * sum(points, boundary),
-                _ => p,
-            }
-        })
-        .collect();
+    let mut out = smoothed(points, &rings, beta, 0.125);
     let first_odd = out.len() as u32;
     for (id, &(a, b)) in edges.ends.iter().enumerate() {
         let (pa, pb) = (points[a as usize], points[b as usize]);
@@ -140,6 +125,20 @@ fn refine(points: &[DVec3], indices: &[u32]) -> (Vec<DVec3>, Vec<u32>) {
 /// Each vertex moved to its limit position on the subdivision surface.
 fn limit(points: &[DVec3], indices: &[u32]) -> Vec<DVec3> {
     let rings = Edges::of(indices).rings(points.len());
+    let gamma = |n: usize| 1.0 / (n as f64 + 3.0 / (8.0 * beta(n)));
+    smoothed(points, &rings, gamma, 0.2)
+}
+
+/// Every vertex moved by Loop's masks: an interior vertex of valence n to
+/// (1 − n w) v + w Σ neighbours with w = `interior(n)`, a boundary vertex to
+/// (1 − 2 b) v + b Σ of its two boundary neighbours, others left in place. The even
+/// rule and the limit rule differ only in these weights.
+fn smoothed(
+    points: &[DVec3],
+    rings: &Rings,
+    interior: impl Fn(usize) -> f64,
+    boundary_weight: f64,
+) -> Vec<DVec3> {
     points
         .iter()
         .enumerate()
@@ -148,11 +147,10 @@ fn limit(points: &[DVec3], indices: &[u32]) -> Vec<DVec3> {
             let ring = &rings.neighbours[v];
             match boundary.len() {
                 0 if ring.len() >= 3 => {
-                    let n = ring.len();
-                    let gamma = 1.0 / (n as f64 + 3.0 / (8.0 * beta(n)));
-                    (1.0 - n as f64 * gamma) * p + gamma * sum(points, ring)
+                    let w = interior(ring.len());
+                    (1.0 - ring.len() as f64 * w) * p + w * sum(points, ring)
                 }
-                2 => 0.6 * p + 0.2 * sum(points, boundary),
+                2 => (1.0 - 2.0 * boundary_weight) * p + boundary_weight * sum(points, boundary),
                 _ => p,
             }
         })
