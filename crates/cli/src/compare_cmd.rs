@@ -4,8 +4,13 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
+use radiant::color::Rgb;
+use radiant::image::exr::read_exr_attributes;
 use radiant::image::falsecolor::{ErrorMetric, false_color_error};
-use radiant::image::{Crop, ImageMeta, compare, read_image, write_image};
+use radiant::image::flip::{DEFAULT_PIXELS_PER_DEGREE, FlipMap};
+use radiant::image::png::srgb_eotf;
+use radiant::image::{Crop, Image, ImageMeta, compare, read_image, write_image};
+use radiant::report::{Effort, write_report};
 
 /// Arguments of `radiant compare`.
 #[derive(clap::Args, Debug)]
@@ -27,6 +32,15 @@ pub struct CompareArgs {
     /// Print one JSON object instead of one figure per line.
     #[arg(long)]
     pub json: bool,
+    /// Also compute the mean HDR-ꟻLIP error (Andersson et al. 2020, 2021) of the linear
+    /// images at the default viewing condition (67 pixels per degree), over --crop; with
+    /// --diff the PNG shows the ꟻLIP map (magma colours) instead.
+    #[arg(long)]
+    pub flip: bool,
+    /// Also write the interactive report viewer (zoom, swipe, exposure, error views)
+    /// for the two images.
+    #[arg(long, value_name = "OUT.html")]
+    pub html: Option<PathBuf>,
 }
 
 /// Runs the comparison and prints the figures.
@@ -43,8 +57,24 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         )
     };
     let m = compare(&test, &reference, args.crop).with_context(context)?;
+    let flip = if args.flip {
+        Some(
+            radiant::study::measure(&test, &reference, args.crop, DEFAULT_PIXELS_PER_DEGREE)
+                .with_context(context)?,
+        )
+    } else {
+        None
+    };
+    if let Some(out) = &args.html {
+        write_html(out, &args, &test, &reference)?;
+    }
 
     let diff_scale = match &args.diff {
+        Some(out) if flip.is_some() => {
+            let map = &flip.as_ref().expect("computed above").flip;
+            write_flip_png(out, map)?;
+            None
+        }
         Some(out) => {
             let fc = false_color_error(
                 &test,
@@ -72,6 +102,9 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         if let Some(s) = diff_scale {
             fields.push(format!("\"diff_scale\": {}", json_number(s as f64)));
         }
+        if let Some(f) = &flip {
+            fields.push(format!("\"flip_mean\": {}", json_number(f.flip_mean)));
+        }
         println!("{{{}}}", fields.join(", "));
     } else {
         for (name, v) in [
@@ -87,8 +120,73 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         if let Some(s) = diff_scale {
             println!("diff_scale {}", format_g(s as f64, 6));
         }
+        if let Some(f) = &flip {
+            println!("flip_mean {}", format_g(f.flip_mean, 6));
+        }
     }
     Ok(())
+}
+
+/// The ꟻLIP map as a PNG of its magma colours (the 8-bit values are decoded to linear
+/// so the sRGB writer puts back exactly those bytes).
+fn write_flip_png(out: &std::path::Path, map: &FlipMap) -> anyhow::Result<()> {
+    let pixels = map
+        .to_magma()
+        .iter()
+        .map(|c| Rgb::from_array(c.map(|b| srgb_eotf(f32::from(b) / 255.0))))
+        .collect();
+    let image = Image {
+        width: map.width,
+        height: map.height,
+        pixels,
+    };
+    write_image(out, &image, &ImageMeta::default(), 0.0)
+        .with_context(|| format!("cannot write {}", out.display()))
+}
+
+/// The report viewer with TEST as the one method against REF; samples and time come
+/// from the EXR header when it has them.
+fn write_html(
+    out: &std::path::Path,
+    args: &CompareArgs,
+    test: &Image,
+    reference: &Image,
+) -> anyhow::Result<()> {
+    let attrs = read_exr_attributes(&args.test).ok();
+    let spp = attrs
+        .as_ref()
+        .and_then(|a| a.samples_per_pixel)
+        .unwrap_or(0);
+    let seconds = attrs
+        .as_ref()
+        .and_then(|a| a.render_time_seconds)
+        .map_or(0.0, f64::from);
+    let name = args
+        .test
+        .file_name()
+        .map_or_else(|| "test".to_string(), |n| n.to_string_lossy().into_owned());
+    let mut report = radiant::study::comparison_report(
+        &name,
+        test,
+        reference,
+        args.crop,
+        DEFAULT_PIXELS_PER_DEGREE,
+        seconds,
+        Effort::SamplesPerPixel(spp.max(0) as u64),
+    )
+    .with_context(|| {
+        format!(
+            "comparing {} against {}",
+            args.test.display(),
+            args.reference.display()
+        )
+    })?;
+    report
+        .notes
+        .push(format!("reference: {}", args.reference.display()));
+    let html = write_report(&report);
+    radiant::image::atomic::atomic_write_bytes(out, html.as_bytes())
+        .with_context(|| format!("cannot write {}", out.display()))
 }
 
 /// A JSON number; JSON has no NaN or infinity, so those become `null`.

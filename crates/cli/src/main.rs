@@ -6,6 +6,7 @@ mod lens_cmd;
 mod radiosity_cmd;
 mod render_cmd;
 mod signals;
+mod study_cmd;
 
 use clap::{Parser, Subcommand};
 
@@ -33,6 +34,9 @@ enum Command {
     /// Solve diffuse interreflection on a patch mesh (radiosity): energy balance, lit
     /// mesh export (glTF, PLY), patch table, image or progressive image sequence.
     Radiosity(radiosity_cmd::RadiosityArgs),
+    /// Render a scene with several methods (path, sppm, photonmap, radiosity), measure
+    /// each snapshot against a reference, and write one interactive HTML report.
+    Study(study_cmd::StudyArgs),
 }
 
 fn main() {
@@ -43,6 +47,7 @@ fn main() {
         Command::Lens(args) => lens_cmd::run(args),
         Command::Bench(args) => bench_cmd::run(args),
         Command::Radiosity(args) => radiosity_cmd::run(args),
+        Command::Study(args) => study_cmd::run(args),
     };
     if let Err(e) = result {
         eprintln!("radiant: {e:#}");

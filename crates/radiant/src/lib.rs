@@ -13,11 +13,13 @@ pub use radiant_math as math;
 pub use radiant_math::color;
 pub use radiant_radiosity as radiosity;
 pub use radiant_render as render;
+pub use radiant_report as report;
 pub use radiant_scene as scene;
 
 pub mod checkpoint;
 pub mod integrators;
 pub mod session;
+pub mod study;
 
 pub use integrators::{INTEGRATOR_NAMES, integrator_from_desc};
 pub use session::Session;
