@@ -37,8 +37,11 @@ fn s(p: &Path) -> &str {
     p.to_str().expect("UTF-8 path")
 }
 
-/// The metrics table of a report: per `data-method` row, `data-key` → `data-value`.
-fn table(html: &str) -> Vec<(String, Vec<(String, Option<f64>)>)> {
+/// One row of the metrics table: `data-key` → `data-value`.
+type Row = Vec<(String, Option<f64>)>;
+
+/// The metrics table of a report: per `data-method` row, its cells.
+fn table(html: &str) -> Vec<(String, Row)> {
     let body = &html[html.find("<tbody>").expect("table body")..];
     let body = &body[..body.find("</tbody>").expect("table body end")];
     body.split("<tr data-method=\"")
@@ -67,19 +70,34 @@ fn cell(row: &[(String, Option<f64>)], key: &str) -> Option<f64> {
         .1
 }
 
-/// `radiant compare TEST REF --json --flip [--crop C]` as JSON.
-fn compare_json(test: &Path, reference: &Path, crop: Option<&str>) -> Value {
+/// What `radiant compare TEST REF --json --flip [--crop C]` prints.
+fn compare_json(test: &Path, reference: &Path, crop: Option<&str>) -> String {
     let mut args = vec!["compare", s(test), s(reference), "--json", "--flip"];
     if let Some(c) = crop {
         args.extend(["--crop", c]);
     }
-    let (stdout, _) = radiant(&args);
-    serde_json::from_str(stdout.trim()).unwrap_or_else(|e| panic!("{e}: {stdout}"))
+    radiant(&args).0.trim().to_string()
+}
+
+/// The text of number `key` in a flat JSON object. Read as text and parsed with Rust's
+/// correctly rounded parser: serde_json's default float parsing may be off by an ulp.
+fn field<'a>(json: &'a str, key: &str) -> &'a str {
+    let marker = format!("\"{key}\": ");
+    let at = json
+        .find(&marker)
+        .unwrap_or_else(|| panic!("no {key} in {json}"))
+        + marker.len();
+    let rest = &json[at..];
+    rest[..rest.find([',', '}']).unwrap()].trim()
+}
+
+fn number(json: &str, key: &str) -> Option<f64> {
+    field(json, key).parse().ok()
 }
 
 /// Every number of the report's table row equals compare's, exactly (both print the
 /// shortest representation that round-trips).
-fn assert_row_matches(row: &[(String, Option<f64>)], cmp: &Value, what: &str) {
+fn assert_row_matches(row: &[(String, Option<f64>)], cmp: &str, what: &str) {
     for (key, json_key) in [
         ("relmse", "relmse"),
         ("rmse", "rmse"),
@@ -88,7 +106,7 @@ fn assert_row_matches(row: &[(String, Option<f64>)], cmp: &Value, what: &str) {
     ] {
         assert_eq!(
             cell(row, key),
-            cmp[json_key].as_f64(),
+            number(cmp, json_key),
             "{what}: {key} in the report vs compare {cmp}"
         );
     }
@@ -251,10 +269,11 @@ fn study_report_agrees_with_compare_and_checks_itself_in_chromium() {
             ("mae", "mae"),
             ("flip", "flip_mean"),
         ] {
+            // Both sides print the shortest round-trip digits: equal text, read alike.
+            let want: Value = serde_json::from_str(field(cmp, json_key)).unwrap();
             assert_eq!(
-                row["cells"][key]["value"].as_f64(),
-                cmp[json_key].as_f64(),
-                "{label} {key}: page vs compare"
+                row["cells"][key]["value"], want,
+                "{label} {key}: page vs compare {cmp}"
             );
         }
     }
@@ -296,7 +315,7 @@ fn crop_on_a_realistic_camera() {
         assert_row_matches(row, &compare_json(&test, &reference, Some(crop)), label);
         // The crop matters: the whole image's relMSE differs.
         let whole = compare_json(&test, &reference, None);
-        assert_ne!(cell(row, "relmse"), whole["relmse"].as_f64(), "{label}");
+        assert_ne!(cell(row, "relmse"), number(&whole, "relmse"), "{label}");
     }
 }
 
@@ -330,5 +349,63 @@ fn path_tracer_relmse_falls_as_one_over_n() {
     assert!(
         (slope + 1.0).abs() <= 0.1,
         "relMSE slope {slope}:\n{stdout}"
+    );
+}
+
+#[test]
+fn compare_flip_diff_and_html() {
+    let dir = temp_dir("compare");
+    let refs = radiant_testkit::shared_root().join("refs");
+    let (box_ref, caustics) = (
+        refs.join("cornell-box-256-ref.exr"),
+        refs.join("cornell-caustics-256-ref.exr"),
+    );
+    let diff = dir.join("flip.png");
+    let page = dir.join("pair.html");
+    let (stdout, _) = radiant(&[
+        "compare",
+        s(&caustics),
+        s(&box_ref),
+        "--flip",
+        "--diff",
+        s(&diff),
+        "--html",
+        s(&page),
+    ]);
+    let flip: f64 = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("flip_mean "))
+        .unwrap_or_else(|| panic!("{stdout}"))
+        .parse()
+        .unwrap();
+    // Two different scenes: a large perceived difference, but not everywhere maximal.
+    assert!(flip > 0.05 && flip < 0.9, "flip {flip}");
+    // The --diff PNG is the ꟻLIP map in magma: its mean, read back through the colour
+    // map's lightness order, matches the printed mean to within 8-bit quantisation.
+    let png = radiant::image::png::read_png(&diff).unwrap();
+    assert_eq!((png.width, png.height), (256, 256));
+    let magma = radiant::image::flip::MAGMA;
+    let to_byte = |v: f32| radiant::image::png::encode_srgb8(v);
+    let mut sum = 0.0;
+    for p in &png.pixels {
+        let c = p.to_array().map(to_byte);
+        let i = magma.iter().position(|m| *m == c).expect("a magma colour");
+        sum += i as f64 / 255.0;
+    }
+    let mean = sum / png.pixels.len() as f64;
+    assert!((mean - flip).abs() < 2.0 / 255.0, "{mean} vs {flip}");
+    // An image against itself: no ꟻLIP error.
+    let (same, _) = radiant(&["compare", s(&box_ref), s(&box_ref), "--flip", "--json"]);
+    assert!(same.contains("\"flip_mean\": 0.0"), "{same}");
+
+    let html = std::fs::read_to_string(&page).unwrap();
+    let rows = table(&html);
+    assert_eq!(rows.len(), 1);
+    assert_eq!(rows[0].0, "cornell-caustics-256-ref.exr");
+    assert_row_matches(&rows[0].1, &compare_json(&caustics, &box_ref, None), "pair");
+    assert_eq!(
+        html.matches("class=\"panel\"").count(),
+        2,
+        "reference and test"
     );
 }
