@@ -8,10 +8,12 @@
 //!   pass, less the time spent here measuring snapshots.
 //! - **Equal time** runs passes until the budget is spent: after every pass boundary
 //!   (the render's checkpoint hook) the render stops when the time so far plus half the
-//!   last pass reaches the budget, i.e. at the boundary nearest the budget if the next
-//!   pass lasts as long as the last one. The first boundary never stops a render, since
-//!   its "pass" includes the method's preparation. A render thus always ends on a pass
-//!   boundary, with the same number of samples in every pixel.
+//!   predicted next pass reaches the budget, i.e. at the boundary nearest the budget. The
+//!   next pass is predicted from the last pass's time per sample and the pass schedule
+//!   (passes double up to 64 spp; SPPM: one iteration). At the first boundary nothing is
+//!   predicted, as its pass includes the method's preparation: it stops only a render
+//!   already over the budget. A render thus always ends on a pass boundary, with the same
+//!   number of samples in every pixel, and a method's preparation is never cut short.
 //! - **Snapshots** are the renders' own, at powers of two of samples per pixel (SPPM:
 //!   iterations), plus the final image when its count is not a power of two.
 //! - **Errors** are `radiant_image::metrics::compare`'s relMSE, RMSE and MAE, and the
@@ -307,6 +309,17 @@ impl Clock {
     }
 }
 
+/// Samples per pixel (SPPM: iterations) of the pass after the boundary at `done`: SPPM
+/// does one iteration per boundary; the per-pixel integrators' passes
+/// (`radiant_render::integrator::passes`) double from 1, 1, 2, 4 up to 64 spp. Only a
+/// prediction for the equal-time stop: a wrong guess moves the stop by a pass.
+fn next_pass(integrator: &str, done: u32) -> u32 {
+    match integrator {
+        "sppm" => 1,
+        _ => done.clamp(1, 64),
+    }
+}
+
 /// One render of `integrator` under `budget`, calling `at_snapshot(samples, seconds,
 /// image)` off the clock at every snapshot. Returns the final image, its samples and the
 /// method's seconds.
@@ -346,21 +359,21 @@ fn render_method(
             failure = Some(e);
         }
     };
-    let mut boundaries = 0u32;
-    let mut last_boundary = 0.0f64;
-    let mut hook = |_done: u32, _state: &dyn Fn() -> IntegratorState| {
+    // (samples, seconds) at the last pass boundary; `None` before the first.
+    let mut last_boundary: Option<(u32, f64)> = None;
+    let mut hook = |done: u32, _state: &dyn Fn() -> IntegratorState| {
         let Budget::Seconds(limit) = budget else {
             return ControlFlow::Continue(());
         };
         let t = clock.seconds();
-        let pass = if boundaries == 0 {
-            0.0
-        } else {
-            t - last_boundary
+        let next = match last_boundary {
+            Some((n, t0)) if done > n => {
+                (t - t0) / f64::from(done - n) * f64::from(next_pass(integrator, done))
+            }
+            _ => 0.0,
         };
-        boundaries += 1;
-        last_boundary = t;
-        if t + 0.5 * pass >= limit {
+        last_boundary = Some((done, t));
+        if t + 0.5 * next >= limit {
             ControlFlow::Break(())
         } else {
             ControlFlow::Continue(())
@@ -644,4 +657,102 @@ pub fn comparison_report(
         }],
         precision: Precision::F32,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiant_math::color::Rgb;
+
+    fn image(w: usize, h: usize, f: impl Fn(usize, usize) -> f32) -> Image {
+        let mut img = Image::new(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                let v = f(x, y);
+                img.set(x, y, Rgb::new(v, 0.5 * v, 0.25 * v));
+            }
+        }
+        img
+    }
+
+    #[test]
+    fn measure_agrees_with_compare_and_the_flip_map() {
+        let reference = image(24, 16, |x, y| 0.1 + 0.03 * (x + y) as f32);
+        let test = image(24, 16, |x, y| {
+            0.1 + 0.03 * (x + y) as f32 + if (x * 7 + y * 3) % 5 == 0 { 0.4 } else { 0.0 }
+        });
+        let crop = Crop {
+            x0: 3,
+            y0: 2,
+            x1: 20,
+            y1: 11,
+        };
+        let whole = measure(&test, &reference, None, DEFAULT_PIXELS_PER_DEGREE).unwrap();
+        let part = measure(&test, &reference, Some(crop), DEFAULT_PIXELS_PER_DEGREE).unwrap();
+        assert_eq!(whole.metrics, compare(&test, &reference, None).unwrap());
+        assert_eq!(
+            part.metrics,
+            compare(&test, &reference, Some(crop)).unwrap()
+        );
+        assert_eq!(whole.flip_mean, whole.flip.mean);
+        assert_eq!(
+            crop_mean(&whole.flip.errors, 24, Crop::full(24, 16)),
+            whole.flip.mean
+        );
+        // The map is the same; only the pixels averaged differ.
+        assert_eq!(part.flip.errors, whole.flip.errors);
+        let by_hand: f64 = (crop.y0..crop.y1)
+            .flat_map(|y| (crop.x0..crop.x1).map(move |x| (x, y)))
+            .map(|(x, y)| f64::from(whole.flip.error_at(x, y)))
+            .sum::<f64>()
+            / (crop.width() * crop.height()) as f64;
+        assert!((part.flip_mean - by_hand).abs() < 1e-12);
+        assert!(whole.flip_mean > 0.0 && whole.metrics.relmse > 0.0);
+
+        let same = measure(&reference, &reference, None, DEFAULT_PIXELS_PER_DEGREE).unwrap();
+        assert_eq!((same.metrics.relmse, same.flip_mean), (0.0, 0.0));
+    }
+
+    #[test]
+    fn non_finite_test_pixels_count_as_black_in_flip_too() {
+        let reference = image(8, 8, |_, _| 0.5);
+        let mut nan = reference.clone();
+        nan.set(3, 3, Rgb::new(f32::NAN, f32::INFINITY, 0.0));
+        let mut black = reference.clone();
+        black.set(3, 3, Rgb::new(0.0, 0.0, 0.0));
+        let a = measure(&nan, &reference, None, DEFAULT_PIXELS_PER_DEGREE).unwrap();
+        let b = measure(&black, &reference, None, DEFAULT_PIXELS_PER_DEGREE).unwrap();
+        assert_eq!(a.flip.errors, b.flip.errors);
+        assert_eq!(a.metrics.relmse, b.metrics.relmse);
+        assert_eq!(a.metrics.nonfinite, 2);
+    }
+
+    #[test]
+    fn pass_prediction_follows_the_schedules() {
+        // Per-pixel passes: 1, 1, 2, 4, … 64, 64: boundaries at 1, 2, 4, …, 64, 128, 192.
+        let schedule: Vec<u32> = [1, 2, 4, 8, 16, 32, 64, 128, 192]
+            .iter()
+            .map(|&d| next_pass("path", d))
+            .collect();
+        assert_eq!(schedule, [1, 2, 4, 8, 16, 32, 64, 64, 64]);
+        assert_eq!(next_pass("sppm", 37), 1);
+    }
+
+    #[test]
+    fn unknown_methods_and_empty_lists_are_refused() {
+        let desc = radiant_scene::builtin::builtin_scene("cornell-box").unwrap();
+        let reference = ReferenceSpec::Image {
+            image: Image::new(4, 4),
+            label: "black".into(),
+        };
+        let config = StudyConfig::new(vec!["bdpt".into()], Budget::Spp(1), reference.clone());
+        let err = run_study("box", &desc, &config, &mut |_| {}).unwrap_err();
+        assert!(
+            matches!(err, StudyError::UnknownMethod(ref m) if m == "bdpt"),
+            "{err}"
+        );
+        let config = StudyConfig::new(vec![], Budget::Spp(1), reference);
+        let err = run_study("box", &desc, &config, &mut |_| {}).unwrap_err();
+        assert!(matches!(err, StudyError::NoMethods), "{err}");
+    }
 }
