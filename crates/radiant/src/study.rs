@@ -232,25 +232,38 @@ impl MethodRun {
     }
 
     /// Least-squares slope of log relMSE against log samples over the later snapshots
-    /// (the report's legend value).
+    /// (the report's legend value); `None` where those span less than a factor of two.
     pub fn slope_vs_samples(&self) -> Option<f64> {
-        let pts: Vec<(f64, f64)> = self
-            .snapshots
-            .iter()
-            .map(|s| (f64::from(s.samples), s.metrics.relmse))
-            .collect();
-        radiant_report::fitted_slope(&pts)
+        spread_slope(
+            self.snapshots
+                .iter()
+                .map(|s| (f64::from(s.samples), s.metrics.relmse)),
+        )
     }
 
-    /// The same against time.
+    /// The same against time (for radiosity, whose solve is most of its time, the
+    /// snapshots are too close in time for a slope).
     pub fn slope_vs_time(&self) -> Option<f64> {
-        let pts: Vec<(f64, f64)> = self
-            .snapshots
-            .iter()
-            .map(|s| (s.seconds, s.metrics.relmse))
-            .collect();
-        radiant_report::fitted_slope(&pts)
+        spread_slope(self.snapshots.iter().map(|s| (s.seconds, s.metrics.relmse)))
     }
+}
+
+/// [`radiant_report::fitted_slope`], when the later half of the points (those it fits)
+/// spans at least a factor of two in x: over less, the slope is noise.
+fn spread_slope(points: impl Iterator<Item = (f64, f64)>) -> Option<f64> {
+    let pts: Vec<(f64, f64)> = points.collect();
+    let tail = &pts[pts.len() / 2..];
+    let (lo, hi) = tail
+        .iter()
+        .map(|p| p.0)
+        .filter(|x| x.is_finite() && *x > 0.0)
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        });
+    if hi < 2.0 * lo {
+        return None;
+    }
+    radiant_report::fitted_slope(&pts)
 }
 
 /// A finished study.
