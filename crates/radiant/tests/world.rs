@@ -144,8 +144,9 @@ fn curved_bilinear_light_is_sampled_consistently() {
 }
 
 /// The integrator's `"string lightsampler"` names the world's light sampler: "power"
-/// (also the default); pbrt-v4's others stand in for it with a warning; anything else
-/// is an error at the parameter. The parameter never counts as unused.
+/// (also the default) or "bvh" (the light tree); pbrt-v4's others stand in for "power"
+/// with a warning; anything else is an error at the parameter. The parameter never
+/// counts as unused.
 #[test]
 fn light_sampler_is_chosen_by_name() {
     let named = |name: &str| {
@@ -157,19 +158,23 @@ fn light_sampler_is_chosen_by_name() {
         ));
         desc
     };
-    let messages = |desc: &SceneDesc| -> Vec<String> {
+    let messages = |desc: &SceneDesc, chosen: &str| -> Vec<String> {
         let session = Session::new(desc, &Overrides::default()).expect("the session builds");
-        assert_eq!(session.ctx.world.light_sampler.name(), "power");
+        assert_eq!(session.ctx.world.light_sampler.name(), chosen);
         session.warnings.iter().map(|w| w.message.clone()).collect()
     };
-    for desc in [cornell_box(), named("power")] {
-        let m = messages(&desc);
+    for (desc, chosen) in [
+        (cornell_box(), "power"),
+        (named("power"), "power"),
+        (named("bvh"), "bvh"),
+    ] {
+        let m = messages(&desc, chosen);
         assert!(!m.iter().any(|m| m.contains("light")), "{m:?}");
     }
-    let m = messages(&named("bvh"));
+    let m = messages(&named("uniform"), "power");
     assert!(
         m.iter()
-            .any(|m| m == "light sampler \"bvh\" is not supported; using \"power\""),
+            .any(|m| m == "light sampler \"uniform\" is not supported; using \"power\""),
         "{m:?}"
     );
     assert!(!m.iter().any(|m| m.contains("not used")), "{m:?}");
@@ -179,7 +184,7 @@ fn light_sampler_is_chosen_by_name() {
     assert!(
         error
             .to_string()
-            .contains("unknown light sampler \"tree\" (radiant has: power)"),
+            .contains("unknown light sampler \"tree\" (radiant has: power, bvh)"),
         "{error}"
     );
 }

@@ -275,15 +275,14 @@ fn mix_amounts_zero_and_one_pick_one_material() {
     }
 }
 
-/// A white conductor with alpha_u = 0.5 along ∂p/∂u and alpha_v = 0.05, seen along the
-/// normal at the first hit of `ray`: f for a light direction tilted by 20° towards
-/// `towards` (a render-space tangent).
-fn anisotropic_f(shape: &str, ray: Ray, towards: Vec3) -> f32 {
-    let w = world(&format!(
-        "WorldBegin\n\
-         Material \"conductor\" \"rgb reflectance\" [ 1 1 1 ] \"float uroughness\" 0.5 \
-         \"float vroughness\" 0.05 \"bool remaproughness\" false\n{shape}"
-    ));
+/// A white conductor with alpha_u = 0.5 along ∂p/∂u and alpha_v = 0.05.
+const ANISOTROPIC_CONDUCTOR: &str = "Material \"conductor\" \"rgb reflectance\" [ 1 1 1 ] \
+    \"float uroughness\" 0.5 \"float vroughness\" 0.05 \"bool remaproughness\" false";
+
+/// `material`, seen along the normal at the first hit of `ray`: f for a light direction
+/// tilted by 20° towards `towards` (a render-space tangent).
+fn anisotropic_f(material: &str, shape: &str, ray: Ray, towards: Vec3) -> f32 {
+    let w = world(&format!("WorldBegin\n{material}\n{shape}"));
     let hit = w.intersect(&ray, f32::INFINITY).expect("a hit");
     let wo = -ray.d.normalize();
     assert!((wo - hit.ns).length() < 1e-4, "seen along the normal");
@@ -297,8 +296,18 @@ fn anisotropic_f(shape: &str, ray: Ray, towards: Vec3) -> f32 {
 
 /// The lobe is wide along ∂p/∂u and narrow across it: f tilted along u is much larger.
 fn assert_stretched_along(shape: &str, ray: Ray, dpdu: Vec3, across: Vec3) {
-    let along_u = anisotropic_f(shape, ray, dpdu);
-    let along_v = anisotropic_f(shape, ray, across);
+    assert_material_stretched_along(ANISOTROPIC_CONDUCTOR, shape, ray, dpdu, across);
+}
+
+fn assert_material_stretched_along(
+    material: &str,
+    shape: &str,
+    ray: Ray,
+    dpdu: Vec3,
+    across: Vec3,
+) {
+    let along_u = anisotropic_f(material, shape, ray, dpdu);
+    let along_v = anisotropic_f(material, shape, ray, across);
     assert!(
         along_u > 20.0 * along_v,
         "{shape}: f along u {along_u}, along v {along_v}"
@@ -332,6 +341,24 @@ fn anisotropic_roughness_follows_dpdu() {
     let rotated =
         "AttributeBegin\nRotate 90 1 0 0\nShape \"sphere\" \"float radius\" 1\nAttributeEnd";
     assert_stretched_along(rotated, side, Vec3::Z, Vec3::Y);
+}
+
+/// The layered materials follow ∂p/∂u too: the anisotropic base of a coated
+/// conductor (under a smooth coat) and an anisotropic coat over a diffuse base. Their
+/// BSDF values are random-walk estimates, so each takes many walks.
+#[test]
+fn coated_anisotropic_roughness_follows_dpdu() {
+    let uv_quad = "Shape \"trianglemesh\" \"point3 P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0 ] \
+                   \"integer indices\" [ 0 1 2  0 2 3 ] \"point2 uv\" [ 0 1  0 0  1 0  1 1 ]";
+    let down = Ray::new(Vec3::new(0.1, 0.2, 1.0), -Vec3::Z);
+    let coated_conductor = "Material \"coatedconductor\" \"float interface.roughness\" 0 \
+        \"float conductor.uroughness\" 0.5 \"float conductor.vroughness\" 0.05 \
+        \"rgb reflectance\" [ 1 1 1 ] \"bool remaproughness\" false \"integer nsamples\" 256";
+    assert_material_stretched_along(coated_conductor, uv_quad, down, Vec3::Y, Vec3::X);
+    let coated_diffuse = "Material \"coateddiffuse\" \"float uroughness\" 0.5 \
+        \"float vroughness\" 0.05 \"rgb reflectance\" [ 0 0 0 ] \"bool remaproughness\" false \
+        \"integer nsamples\" 256";
+    assert_material_stretched_along(coated_diffuse, uv_quad, down, Vec3::Y, Vec3::X);
 }
 
 /// White furnace: under a uniform environment of radiance 1, objects that absorb

@@ -13,6 +13,7 @@ mod environment;
 mod infinite;
 mod point;
 mod sampler;
+mod tree;
 
 use glam::{Vec2, Vec3};
 
@@ -21,6 +22,7 @@ pub use environment::{EnvironmentMap, EnvironmentPicture, rotation_of};
 pub use sampler::{
     LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, LightSampler, SampledLight, UnknownLightSampler,
 };
+pub use tree::LightTree;
 
 use crate::geometry::{Aabb, Ray};
 use radiant_math::PI;

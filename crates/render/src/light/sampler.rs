@@ -8,17 +8,17 @@
 //! receiver: photons leave every light in proportion to its power, whatever the
 //! sampler.
 
-use super::{Light, LightSampleContext, SceneSphere};
+use super::{Light, LightSampleContext, LightTree, SceneSphere};
 use radiant_math::Distribution1D;
 
 /// The integrator parameter that names the light sampler (`"string lightsampler"`).
 pub const LIGHT_SAMPLER_PARAM: &str = "lightsampler";
 
 /// Names of the light samplers radiant has; the first is the default.
-pub const LIGHT_SAMPLER_NAMES: [&str; 1] = ["power"];
+pub const LIGHT_SAMPLER_NAMES: [&str; 2] = ["power", "bvh"];
 
 /// pbrt-v4's light samplers that radiant lacks: scenes naming them get the default.
-const PBRT_ONLY_NAMES: [&str; 3] = ["bvh", "uniform", "exhaustive"];
+const PBRT_ONLY_NAMES: [&str; 2] = ["uniform", "exhaustive"];
 
 /// A light and the probability of having chosen it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -31,6 +31,12 @@ pub struct SampledLight {
 pub enum LightSampler {
     /// In proportion to the lights' emitted power, the same for every receiver.
     Power { distribution: Distribution1D },
+    /// By a light tree's estimate of each light's contribution at the receiver
+    /// (pbrt-v4's `"bvh"`); photons still leave in proportion to power.
+    Tree {
+        tree: Box<LightTree>,
+        emission: Distribution1D,
+    },
 }
 
 /// A light sampler's name that is neither radiant's nor pbrt-v4's.
@@ -47,6 +53,17 @@ impl LightSampler {
         }
     }
 
+    /// Chooses lights by a light tree.
+    pub fn tree(lights: &[Light], scene: SceneSphere) -> LightSampler {
+        let LightSampler::Power { distribution } = LightSampler::power(lights, scene) else {
+            unreachable!("the power sampler")
+        };
+        LightSampler::Tree {
+            tree: Box::new(LightTree::new(lights, scene)),
+            emission: distribution,
+        }
+    }
+
     /// The sampler called `name`, and whether it stands in for one of pbrt-v4's that
     /// radiant does not have (the caller warns).
     pub fn by_name(
@@ -56,6 +73,7 @@ impl LightSampler {
     ) -> Result<(LightSampler, bool), UnknownLightSampler> {
         match name {
             "power" => Ok((LightSampler::power(lights, scene), false)),
+            "bvh" => Ok((LightSampler::tree(lights, scene), false)),
             other if PBRT_ONLY_NAMES.contains(&other) => {
                 Ok((LightSampler::power(lights, scene), true))
             }
@@ -66,27 +84,34 @@ impl LightSampler {
     pub fn name(&self) -> &'static str {
         match self {
             LightSampler::Power { .. } => "power",
+            LightSampler::Tree { .. } => "bvh",
         }
     }
 
     /// Picks a light for the receiver `ctx`; `None` when there are none.
-    pub fn sample(&self, _ctx: &LightSampleContext, u: f32) -> Option<SampledLight> {
+    pub fn sample(&self, ctx: &LightSampleContext, u: f32) -> Option<SampledLight> {
         match self {
             LightSampler::Power { distribution } => sample_distribution(distribution, u),
+            LightSampler::Tree { tree, .. } => tree.sample(ctx, u),
         }
     }
 
     /// Probability that `sample` from `ctx` picks light `index`.
-    pub fn pmf(&self, _ctx: &LightSampleContext, index: usize) -> f32 {
+    pub fn pmf(&self, ctx: &LightSampleContext, index: usize) -> f32 {
         match self {
             LightSampler::Power { distribution } => distribution.pmf(index),
+            LightSampler::Tree { tree, .. } => tree.pmf(ctx, index),
         }
     }
 
     /// Picks the light that emits a photon, in proportion to power.
     pub fn sample_emission_light(&self, u: f32) -> Option<SampledLight> {
         match self {
-            LightSampler::Power { distribution } => sample_distribution(distribution, u),
+            LightSampler::Power { distribution }
+            | LightSampler::Tree {
+                emission: distribution,
+                ..
+            } => sample_distribution(distribution, u),
         }
     }
 }
@@ -150,11 +175,13 @@ mod tests {
         let (s, stand_in) = LightSampler::by_name("power", &lights, SCENE).unwrap();
         assert_eq!((s.name(), stand_in), ("power", false));
         let (s, stand_in) = LightSampler::by_name("bvh", &lights, SCENE).unwrap();
+        assert_eq!((s.name(), stand_in), ("bvh", false));
+        let (s, stand_in) = LightSampler::by_name("uniform", &lights, SCENE).unwrap();
         assert_eq!((s.name(), stand_in), ("power", true));
         let e = LightSampler::by_name("tree", &lights, SCENE).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "unknown light sampler \"tree\" (radiant has: power)"
+            "unknown light sampler \"tree\" (radiant has: power, bvh)"
         );
     }
 }

@@ -392,6 +392,16 @@ impl Layered {
         self.albedo.max_component() > 0.0
     }
 
+    /// True when the coat's or the base's roughness differs along the two tangent axes.
+    pub fn is_anisotropic(&self) -> bool {
+        let anisotropic = |d: &Option<TrowbridgeReitz>| d.is_some_and(|d| d.alpha_x != d.alpha_y);
+        let base = match &self.base {
+            Base::Diffuse { .. } => false,
+            Base::Conductor { distribution, .. } => anisotropic(distribution),
+        };
+        anisotropic(&self.coat.distribution) || base
+    }
+
     /// True when every path through the layers is a delta: a smooth coat over a
     /// smooth conductor (parallel mirrors reflect only into the mirror direction).
     pub fn is_delta(&self) -> bool {

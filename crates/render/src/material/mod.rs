@@ -184,6 +184,9 @@ impl Material {
             | Material::RoughDielectric { distribution, .. } => {
                 distribution.alpha_x != distribution.alpha_y
             }
+            Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } => {
+                layers.is_anisotropic()
+            }
             _ => false,
         }
     }

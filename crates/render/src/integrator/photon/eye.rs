@@ -10,10 +10,8 @@ use super::record::FIRST_DIFFUSE;
 use super::settings::Visualize;
 use super::{PhotonMaps, facing};
 use crate::geometry::Ray;
-use crate::integrator::direct::{
-    ShadingPoint, environment, sample_direct, sides_agree, surface_emission,
-};
-use crate::integrator::specular::specular_bounce;
+use crate::integrator::direct::{ShadingPoint, sample_direct, sides_agree};
+use crate::integrator::specular::{ChainVertex, chain_bounce, glossy_direct, specular_bounce};
 use crate::light::SceneSphere;
 use crate::material::{Material, TransportMode};
 use crate::sampler::PixelSample;
@@ -74,28 +72,38 @@ pub fn radiance(
     let mut beta = Rgb::WHITE;
     let mut rays = 0u32;
     let mut travelled = 0.0f32;
+    let mut prev = ChainVertex::camera(ray.o);
     for depth in 0..=settings.max_depth {
         rays += 1;
         let Some(mut hit) = world.intersect(&ray, f32::INFINITY) else {
-            l += beta * environment(world, ray.d);
+            l += beta * prev.environment(world, ray.d);
             break;
         };
         travelled += hit.t * ray.d.length();
         world.add_footprint(&mut hit, ray.d, travelled);
         let wo_world = -ray.d.normalize();
-        let emitted = surface_emission(world, &hit, wo_world);
+        let emitted = prev.emission(world, &hit, wo_world);
         let material = world.material_at(&hit, wo_world);
         let frame = World::shading_frame(&hit, &material);
         if material.passes_photon_paths() {
-            // The camera sees emitters directly or through specular chains only.
+            // The camera sees emitters directly or through specular and rough-glass
+            // chains only; at rough glass a light sample shares the work.
             l += beta * emitted;
             if depth == settings.max_depth {
                 break;
             }
-            let wo = frame.to_local(wo_world);
-            let Some(wi) = specular_bounce(&material, &frame, wo, sampler, &mut beta) else {
+            if !material.is_specular() {
+                let (direct, shadow_rays) =
+                    glossy_direct(world, ctx.scene, &hit, material, wo_world, sampler);
+                rays += shadow_rays;
+                l += beta * direct;
+            }
+            let Some((wi, vertex)) =
+                chain_bounce(&hit, &material, &frame, wo_world, sampler, &mut beta)
+            else {
                 break;
             };
+            prev = vertex;
             ray = hit.spawn_ray(wi);
             continue;
         }

@@ -9,7 +9,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::estimate::{EstimatePoint, PhotonMap, radiance_estimate};
-use super::kdtree::{KdPoint, KdTree, Neighbors};
+use super::kdtree::{self, KdPoint, KdTree, Neighbors};
 use super::record::{oct_decode, oct_encode};
 use super::settings::Kernel;
 use radiant_math::color::Rgb;
@@ -109,6 +109,7 @@ impl IrradianceCache {
             })
             .collect();
         if stop() {
+            kdtree::release(points);
             return None;
         }
         Some(IrradianceCache {

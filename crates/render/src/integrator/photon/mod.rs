@@ -234,6 +234,20 @@ impl PhotonMaps {
             None
         };
         stats.precompute_seconds = t2.elapsed().as_secs_f64();
+        if stop() {
+            // Stopped during (or just after) the irradiance cache: the gigabytes of a
+            // large map go back off the caller's thread, which has an image to write.
+            global.discard();
+            caustic.discard();
+            return PhotonMaps {
+                settings: *settings,
+                global: Default::default(),
+                caustic: Default::default(),
+                irradiance: None,
+                max_r2,
+                stats,
+            };
+        }
         stats.irradiance_points = irradiance.as_ref().map_or(0, |c| c.len() as u64);
         PhotonMaps {
             settings: *settings,

@@ -11,8 +11,8 @@
 use glam::Vec3;
 
 use crate::context::RenderContext;
-use crate::integrator::direct::{ShadingPoint, environment, sample_direct, surface_emission};
-use crate::integrator::specular::specular_bounce;
+use crate::integrator::direct::{ShadingPoint, sample_direct};
+use crate::integrator::specular::{ChainVertex, chain_bounce, glossy_direct};
 use crate::material::Material;
 use crate::world::World;
 use radiant_math::Frame;
@@ -78,17 +78,19 @@ pub fn camera_sample(
     // The sensor is the film's; the camera path starts with the camera's weight.
     let mut beta = Rgb::splat(cr.weight * cs.filter_weight);
     let mut travelled = 0.0f32;
+    let mut prev = ChainVertex::camera(ray.o);
     for depth in 0..=max_depth {
         out.rays += 1;
         let Some(mut hit) = world.intersect(&ray, f32::INFINITY) else {
-            out.ld += beta * environment(world, ray.d);
+            out.ld += beta * prev.environment(world, ray.d);
             break;
         };
         travelled += hit.t * ray.d.length();
         world.add_footprint(&mut hit, ray.d, travelled);
         let wo_world = -ray.d.normalize();
-        // Only specular vertices precede this one: emission always counts.
-        out.ld += beta * surface_emission(world, &hit, wo_world);
+        // Specular and rough-glass vertices precede this one: emission counts in full
+        // after a delta bounce, weighted against the light sample after a glossy one.
+        out.ld += beta * prev.emission(world, &hit, wo_world);
         let material = world.material_at(&hit, wo_world);
         let frame = World::shading_frame(&hit, &material);
         let wo = frame.to_local(wo_world);
@@ -96,9 +98,18 @@ pub fn camera_sample(
             if depth == max_depth {
                 break;
             }
-            let Some(wi) = specular_bounce(&material, &frame, wo, &mut sampler, &mut beta) else {
+            if !material.is_specular() {
+                let (direct, shadow_rays) =
+                    glossy_direct(world, scene, &hit, material, wo_world, &mut sampler);
+                out.rays += shadow_rays;
+                out.ld += beta * direct;
+            }
+            let Some((wi, vertex)) =
+                chain_bounce(&hit, &material, &frame, wo_world, &mut sampler, &mut beta)
+            else {
                 break;
             };
+            prev = vertex;
             ray = hit.spawn_ray(wi);
             continue;
         }
