@@ -6,6 +6,7 @@ mod lens_cmd;
 mod radiosity_cmd;
 mod render_cmd;
 mod signals;
+mod unit_cmd;
 
 use clap::{Parser, Subcommand};
 
@@ -33,6 +34,9 @@ enum Command {
     /// Solve diffuse interreflection on a patch mesh (radiosity): energy balance, lit
     /// mesh export (glTF, PLY), patch table, image or progressive image sequence.
     Radiosity(radiosity_cmd::RadiosityArgs),
+    /// Merge the partial files of a distributed render into its image, bit-identical
+    /// to the render on one machine.
+    Merge(unit_cmd::MergeArgs),
 }
 
 fn main() {
@@ -43,6 +47,7 @@ fn main() {
         Command::Lens(args) => lens_cmd::run(args),
         Command::Bench(args) => bench_cmd::run(args),
         Command::Radiosity(args) => radiosity_cmd::run(args),
+        Command::Merge(args) => unit_cmd::run_merge(args),
     };
     if let Err(e) = result {
         eprintln!("radiant: {e:#}");

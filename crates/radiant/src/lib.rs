@@ -17,6 +17,7 @@ pub use radiant_scene as scene;
 
 pub mod checkpoint;
 pub mod integrators;
+pub mod partial;
 pub mod session;
 
 pub use integrators::{INTEGRATOR_NAMES, integrator_from_desc};
