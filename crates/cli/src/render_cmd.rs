@@ -233,6 +233,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if args.unit.any() && args.checkpoint.target().is_some() {
         bail!("--checkpoint and --resume render the whole image, not a unit of it");
     }
+    args.unit.load_solution(&mut session, &desc)?;
     let unit = args.unit.apply(&mut session)?;
     let image_wanted = args.unit.partial.is_none() || args.output.is_some();
     let ckpt = &args.checkpoint;

@@ -49,6 +49,10 @@ pub struct UnitArgs {
     /// image is written.
     #[arg(long, value_name = "FILE")]
     pub partial: Option<PathBuf>,
+    /// With --integrator radiosity: display this saved solution (`radiant radiosity
+    /// --save-solution`) instead of solving.
+    #[arg(long, value_name = "FILE")]
+    pub solution: Option<PathBuf>,
 }
 
 impl UnitArgs {
@@ -60,6 +64,36 @@ impl UnitArgs {
             || self.sample_range.is_some()
             || self.part.is_some()
             || self.partial.is_some()
+    }
+
+    /// Replaces the session's radiosity integrator by the display of a saved solution.
+    pub fn load_solution(&self, session: &mut Session, desc: &SceneDesc) -> anyhow::Result<()> {
+        let Some(path) = &self.solution else {
+            return Ok(());
+        };
+        if session.integrator.name() != "radiosity" {
+            bail!("--solution: for the radiosity integrator (--integrator radiosity)");
+        }
+        let placeholder: Box<dyn radiant::render::Integrator> =
+            Box::new(radiant::render::integrator::PathIntegrator {
+                settings: Default::default(),
+            });
+        let integrator = std::mem::replace(&mut session.integrator, placeholder);
+        let integrator: Box<dyn std::any::Any> = integrator;
+        let radiosity = *integrator
+            .downcast::<radiant::radiosity::RadiosityIntegrator>()
+            .map_err(|_| anyhow::anyhow!("--solution: the integrator is not radiosity"))?;
+        let solution = radiant::solution::read(
+            path,
+            radiant::checkpoint::scene_hash(desc),
+            &radiosity.scene,
+        )
+        .with_context(|| format!("--solution {}", path.display()))?;
+        session.integrator = Box::new(radiant::solution::SolvedRadiosity {
+            radiosity,
+            solution,
+        });
+        Ok(())
     }
 
     /// Sets the session's work unit from the flags, checked against the render.

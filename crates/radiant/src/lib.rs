@@ -19,6 +19,7 @@ pub mod checkpoint;
 pub mod integrators;
 pub mod partial;
 pub mod session;
+pub mod solution;
 
 pub use integrators::{INTEGRATOR_NAMES, integrator_from_desc};
 pub use session::Session;
