@@ -70,6 +70,11 @@ fn assert_merges_exactly(desc: &SceneDesc, integrator: &str, spp: u32, res: u32,
             differing, 0,
             "{integrator}, {n} parts by {split:?}: {differing} channel values differ"
         );
+        assert_eq!(
+            sum_bits(&merged),
+            sum_bits(&whole.film),
+            "{integrator}, {n} parts"
+        );
     }
 }
 
@@ -193,4 +198,85 @@ fn units_off_the_sample_blocks_or_the_image_are_refused() {
     // pbrt-v4's crop window: edges at ceil(resolution × fraction).
     let b = partial::crop_window_bounds((10, 20), [0.25, 0.75, 0.0, 0.5]);
     assert_eq!((b.x0, b.x1, b.y0, b.y1), (3, 8, 0, 10));
+}
+
+fn sum_bits(film: &radiant::image::Film) -> Vec<u64> {
+    film.pixels
+        .iter()
+        .flat_map(|p| {
+            [
+                p.sum[0].to_bits(),
+                p.sum[1].to_bits(),
+                p.sum[2].to_bits(),
+                p.weight.to_bits(),
+            ]
+        })
+        .collect()
+}
+
+/// Radiance spanning sixty binary orders of magnitude from sample to sample: the f64
+/// sums of a pixel are then inexact, and their grouping shows in the bits.
+struct WideRange;
+
+impl radiant::render::integrator::PixelEstimator for WideRange {
+    type Scratch = ();
+
+    fn scratch(&self) {}
+
+    fn radiance(
+        &self,
+        _ray: radiant::render::geometry::Ray,
+        sampler: &mut radiant::render::sampler::PixelSample,
+        _pixel: radiant::render::integrator::PixelId,
+        _scratch: &mut (),
+    ) -> (radiant::color::Rgb, u32) {
+        let u = sampler.get_2d();
+        let v = (2.0f32).powi((u.x * 60.0) as i32 - 30) * (1.0 + u.y);
+        (radiant::color::Rgb::splat(v), 1)
+    }
+}
+
+#[test]
+fn sample_ranges_merge_exactly_where_the_sums_round() {
+    use radiant::render::integrator::{RenderControl, render_passes};
+    let desc = cornell_box();
+    let spp = 5 * SAMPLE_BLOCK + 7;
+    let mut s = session(&desc, "path", spp, 8);
+    let progress = radiant::render::Progress::default();
+    let render = |s: &Session| {
+        render_passes(
+            &s.ctx,
+            &WideRange,
+            &mut RenderControl::new(&progress, &mut |_, _| {}),
+        )
+    };
+    let whole = render(&s);
+    let reference = bits(&whole.film.image());
+    let (res, key) = (s.ctx.resolution, s.run_key(&desc));
+    for n in [2, 3, 5] {
+        let mut parts = Vec::new();
+        let mut naive = radiant::image::Film::new(8, 8, whole.film.sensor);
+        for k in 0..n {
+            let unit = partial::part_unit(res, spp, k, n, Split::Samples).unwrap();
+            s.ctx.work = unit;
+            let out = render(&s);
+            // What a merge without the block grouping would make: the parts' sums
+            // added as they are.
+            for (p, q) in naive.pixels.iter_mut().zip(&out.film.pixels) {
+                radiant::render::integrator::fold(p, q);
+            }
+            let part = Partial::from_output(key.clone(), unit, Some((k, n)), out);
+            parts.push((format!("{k}/{n}"), Partial::decode(&part.encode()).unwrap()));
+        }
+        let merged = partial::merge(&parts).unwrap();
+        assert_eq!(bits(&merged.image()), reference, "{n} parts");
+        // The f64 sums themselves are the same bits (the f32 image hides most of the
+        // rounding), and differ without the grouping.
+        assert_eq!(sum_bits(&merged), sum_bits(&whole.film), "{n} parts");
+        assert_ne!(
+            sum_bits(&naive),
+            sum_bits(&whole.film),
+            "{n} parts: the sums are exact here, so the test shows nothing"
+        );
+    }
 }
