@@ -297,6 +297,10 @@ fn render(
     let mean_r2 = state.iter().map(|s| s.r2).sum::<f64>() / n_pix.max(1) as f64;
     stats.final_radius = mean_r2.sqrt() as f32;
     write_estimates(&mut film, &state, done, n_photons);
+    // Pixels are named in the full image's coordinates.
+    if let Some((x, y)) = film.nonfinite.first_pixel {
+        film.nonfinite.first_pixel = Some((x + x0, y + y0));
+    }
     let interrupted = done < ctx.spp;
     RenderOutput {
         state: control.final_state(|| snapshot_state(&state, done)),
