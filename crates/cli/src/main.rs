@@ -7,6 +7,8 @@ mod radiosity_cmd;
 mod render_cmd;
 mod signals;
 mod study_cmd;
+mod slurm_cmd;
+mod unit_cmd;
 
 use clap::{Parser, Subcommand};
 
@@ -37,6 +39,12 @@ enum Command {
     /// Render a scene with several methods (path, sppm, photonmap, radiosity), measure
     /// each snapshot against a reference, and write one interactive HTML report.
     Study(study_cmd::StudyArgs),
+    /// Merge the partial files of a distributed render into its image, bit-identical
+    /// to the render on one machine.
+    Merge(unit_cmd::MergeArgs),
+    /// Write (and with --submit, submit) a Slurm array job of a render's parts and a
+    /// merge job that runs after them.
+    Slurm(slurm_cmd::SlurmArgs),
 }
 
 fn main() {
@@ -48,6 +56,8 @@ fn main() {
         Command::Bench(args) => bench_cmd::run(args),
         Command::Radiosity(args) => radiosity_cmd::run(args),
         Command::Study(args) => study_cmd::run(args),
+        Command::Merge(args) => unit_cmd::run_merge(args),
+        Command::Slurm(args) => slurm_cmd::run(args),
     };
     if let Err(e) = result {
         eprintln!("radiant: {e:#}");

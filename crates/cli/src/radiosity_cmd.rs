@@ -126,6 +126,10 @@ pub struct RadiosityArgs {
     /// Rows of elements halving towards contact edges, this many levels ("contactgrading").
     #[arg(long, value_name = "LEVELS")]
     pub contact_grading: Option<u32>,
+    /// Save the solution to FILE for `radiant render --integrator radiosity --solution
+    /// FILE` (the display of a distributed render, solved once).
+    #[arg(long, value_name = "FILE")]
+    pub save_solution: Option<PathBuf>,
     /// Samples per pixel of the images.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: Option<u32>,
@@ -455,6 +459,23 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         );
     }
     println!("{}", solution.balance.summary());
+    if let Some(path) = &args.save_solution
+        && !solution.interrupted
+    {
+        if solved.scene.is_some() {
+            bail!("--save-solution: not with --refine (the refined mesh is not saved)");
+        }
+        radiant::solution::write(
+            path,
+            radiant::checkpoint::scene_hash(&desc),
+            scene,
+            solution,
+        )
+        .with_context(|| format!("writing the solution {}", path.display()))?;
+        if !args.quiet {
+            eprintln!("solution: {}", path.display());
+        }
+    }
     // A solve cut short is not the solution: writing it would replace good exports and
     // images with ones that look finished.
     if solution.interrupted {

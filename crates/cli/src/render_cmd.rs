@@ -58,6 +58,8 @@ pub struct RenderArgs {
     pub memory_limit: Option<u64>,
     #[command(flatten)]
     pub checkpoint: CheckpointArgs,
+    #[command(flatten)]
+    pub unit: crate::unit_cmd::UnitArgs,
 }
 
 /// Checkpoint and resume flags (shared by `render` and `radiosity`).
@@ -222,10 +224,18 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         resolution: args.resolution,
         integrator: args.integrator.clone(),
     };
-    let session = Session::new(&desc, &overrides)?;
+    let mut session = Session::new(&desc, &overrides)?;
     for w in &session.warnings {
         eprintln!("{w}");
     }
+    // A unit of a distributed render restarts whole: its checkpoint would be its
+    // partial file.
+    if args.unit.any() && args.checkpoint.target().is_some() {
+        bail!("--checkpoint and --resume render the whole image, not a unit of it");
+    }
+    args.unit.load_solution(&mut session, &desc)?;
+    let unit = args.unit.apply(&mut session)?;
+    let image_wanted = args.unit.partial.is_none() || args.output.is_some();
     let ckpt = &args.checkpoint;
     let key = ckpt.target().map(|_| session.run_key(&desc));
     let resume = match &key {
@@ -326,12 +336,20 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             output.display()
         );
     }
+    if args.unit.partial.is_some() {
+        if output_data.interrupted {
+            bail!("interrupted: the unit's partial file is not written (run the unit again)");
+        }
+        let _writing = interrupts.writing();
+        args.unit
+            .write_partial(&session, &desc, unit, &mut output_data)?;
+    }
     let meta = ImageMeta {
         samples_per_pixel: Some(output_data.spp_done),
         render_time_seconds: Some(output_data.seconds),
         software: format!("radiant {}", env!("CARGO_PKG_VERSION")),
     };
-    {
+    if image_wanted {
         let _writing = interrupts.writing();
         write_image(&output, &output_data.film.image(), &meta, args.exposure)
             .with_context(|| format!("writing {}", output.display()))?;

@@ -18,8 +18,10 @@ pub use radiant_scene as scene;
 
 pub mod checkpoint;
 pub mod integrators;
+pub mod partial;
 pub mod session;
 pub mod study;
+pub mod solution;
 
 pub use integrators::{INTEGRATOR_NAMES, integrator_from_desc};
 pub use session::Session;

@@ -95,13 +95,13 @@ impl Session {
                     wanted: wanted.name(),
                 });
             }
-            if state.resolution() != self.ctx.resolution {
+            if state.resolution() != self.ctx.film_size() {
                 return Err(CheckpointError::Payload(format!(
                     "a {}x{} image for a {}x{} render",
                     state.resolution().0,
                     state.resolution().1,
-                    self.ctx.resolution.0,
-                    self.ctx.resolution.1
+                    self.ctx.film_size().0,
+                    self.ctx.film_size().1
                 )));
             }
         }

@@ -44,6 +44,88 @@ impl Progress {
     }
 }
 
+/// Samples per block of the film's accumulation: a pixel's samples are summed in order
+/// within blocks `[0, 64)`, `[64, 128)`, … (the last ends at the render's spp), and the
+/// block sums are added to the pixel in block order. A render split into sample ranges
+/// on block boundaries therefore merges to the same bits as one render: floating-point
+/// addition is not associative, so the grouping of the sum is fixed once and for all.
+/// Renders of at most 64 samples per pixel are one block (a plain running sum). The
+/// size equals the pass loop's largest pass, so passes past the first block are blocks.
+pub const SAMPLE_BLOCK: u32 = 64;
+
+/// A rectangle of pixels `[x0, x1) × [y0, y1)` of the full image (pbrt-v4's
+/// `pixelbounds`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PixelBounds {
+    pub x0: u32,
+    pub x1: u32,
+    pub y0: u32,
+    pub y1: u32,
+}
+
+impl PixelBounds {
+    /// The whole of a `w × h` image.
+    pub fn full(resolution: (u32, u32)) -> PixelBounds {
+        PixelBounds {
+            x0: 0,
+            x1: resolution.0,
+            y0: 0,
+            y1: resolution.1,
+        }
+    }
+
+    pub fn width(&self) -> u32 {
+        self.x1.saturating_sub(self.x0)
+    }
+
+    pub fn height(&self) -> u32 {
+        self.y1.saturating_sub(self.y0)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.width() == 0 || self.height() == 0
+    }
+
+    pub fn contains(&self, x: u32, y: u32) -> bool {
+        (self.x0..self.x1).contains(&x) && (self.y0..self.y1).contains(&y)
+    }
+
+    /// The overlap of two rectangles (empty when they do not meet).
+    pub fn intersect(&self, other: &PixelBounds) -> PixelBounds {
+        PixelBounds {
+            x0: self.x0.max(other.x0),
+            x1: self.x1.min(other.x1),
+            y0: self.y0.max(other.y0),
+            y1: self.y1.min(other.y1),
+        }
+    }
+}
+
+impl std::fmt::Display for PixelBounds {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{},{},{},{}", self.x0, self.x1, self.y0, self.y1)
+    }
+}
+
+/// The share of a render one job computes: the pixels of a rectangle and, of each,
+/// the samples `[samples.0, samples.1)`. Every sample is a function of (pixel, sample
+/// index, seed) alone, so a unit draws exactly the samples the full render draws there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WorkUnit {
+    pub pixels: PixelBounds,
+    pub samples: (u32, u32),
+}
+
+impl WorkUnit {
+    /// All pixels, all samples.
+    pub fn full(resolution: (u32, u32), spp: u32) -> WorkUnit {
+        WorkUnit {
+            pixels: PixelBounds::full(resolution),
+            samples: (0, spp),
+        }
+    }
+}
+
 /// Everything an integrator needs besides its own settings.
 pub struct RenderContext {
     pub world: World,
@@ -55,6 +137,9 @@ pub struct RenderContext {
     pub resolution: (u32, u32),
     /// Samples per pixel (SPPM: iterations).
     pub spp: u32,
+    /// The pixels and samples to render (all of them unless set after `new`); the film
+    /// covers `work.pixels` only.
+    pub work: WorkUnit,
 }
 
 /// One pixel sample's camera ray.
@@ -118,6 +203,7 @@ impl RenderContext {
             FilterKind::Triangle => Filter::triangle(desc.filter.radius),
             FilterKind::Gaussian { sigma } => Filter::gaussian(desc.filter.radius, sigma),
         };
+        let spp = spp.max(1);
         let context = RenderContext {
             world,
             camera,
@@ -126,18 +212,21 @@ impl RenderContext {
             seed: overrides.seed.unwrap_or(desc.sampler.seed),
             sensor: Sensor::new(desc.film.iso, 1.0),
             resolution,
-            spp: overrides.spp.unwrap_or(desc.sampler.pixel_samples).max(1),
+            spp,
+            work: WorkUnit::full(resolution, spp),
         };
         Ok((context, warnings))
     }
 
-    /// An empty film of the image's size, recording through the scene's sensor.
+    /// An empty film of the work unit's pixels, recording through the scene's sensor.
     pub fn new_film(&self) -> Film {
-        Film::new(
-            self.resolution.0 as usize,
-            self.resolution.1 as usize,
-            self.sensor,
-        )
+        let (w, h) = self.film_size();
+        Film::new(w as usize, h as usize, self.sensor)
+    }
+
+    /// The film's size: the work unit's pixel rectangle.
+    pub fn film_size(&self) -> (u32, u32) {
+        (self.work.pixels.width(), self.work.pixels.height())
     }
 
     /// The pixel sampler of sample `index` of pixel `(x, y)`, with stream `seed`.

@@ -16,5 +16,7 @@ pub mod sampler;
 pub mod texture;
 pub mod world;
 
-pub use context::{CameraSample, Overrides, Progress, RenderContext};
+pub use context::{
+    CameraSample, Overrides, PixelBounds, Progress, RenderContext, SAMPLE_BLOCK, WorkUnit,
+};
 pub use integrator::{Integrator, RenderControl, RenderOutput, Stats};

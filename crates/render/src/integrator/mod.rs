@@ -20,7 +20,7 @@ pub mod state;
 use std::any::Any;
 use std::fmt;
 
-pub use passes::{PixelEstimator, PixelId, render_passes};
+pub use passes::{PixelEstimator, PixelId, fold, render_passes};
 pub use path::{PathIntegrator, PathSettings};
 pub use photon::{PhotonMapIntegrator, PhotonMapStats, PhotonSettings, Visualize};
 pub use sppm::{SppmIntegrator, SppmSettings, SppmStats};
@@ -108,6 +108,9 @@ pub struct RenderOutput {
     pub state: Option<IntegratorState>,
     /// What the integrator reports beyond the image (photon counts, radii, timings).
     pub stats: Stats,
+    /// For a sample range that starts past sample 0 ([`crate::WorkUnit`]): the film of
+    /// each sample block it covers, in order (`film` is their sum). Empty otherwise.
+    pub blocks: Vec<Film>,
 }
 
 /// An integrator's report: printable, and readable as its own type by those who know it.

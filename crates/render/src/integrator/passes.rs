@@ -10,10 +10,10 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::{IntegratorState, RenderControl, RenderOutput, Stats};
-use crate::context::{Progress, RenderContext};
+use crate::context::{Progress, RenderContext, SAMPLE_BLOCK};
 use crate::geometry::Ray;
 use crate::sampler::PixelSample;
-use radiant_image::{Film, NonFinite};
+use radiant_image::{Film, FilmPixel, NonFinite};
 use radiant_math::color::Rgb;
 
 /// Which sample of which pixel is being estimated.
@@ -43,8 +43,11 @@ pub trait PixelEstimator: Sync {
     ) -> (Rgb, u32);
 }
 
-/// Takes `ctx.spp` samples per pixel with `estimator` into a new film, or into the
-/// film of `control.resume`, continuing each pixel after the samples it has.
+/// Takes samples `ctx.work.samples` of each pixel of `ctx.work.pixels` with
+/// `estimator` into a new film, or into the film of `control.resume`, continuing each
+/// pixel after the samples it has. A sample range that starts past 0 also returns the
+/// film of each [`SAMPLE_BLOCK`] it covers ([`RenderOutput::blocks`]), which is what a
+/// merge adds to the films of the samples before it.
 pub fn render_passes<E: PixelEstimator>(
     ctx: &RenderContext,
     estimator: &E,
@@ -52,9 +55,13 @@ pub fn render_passes<E: PixelEstimator>(
 ) -> RenderOutput {
     let start = Instant::now();
     let progress = control.progress;
+    let (first, end) = ctx.work.samples;
+    if first > 0 {
+        return render_blocks(ctx, estimator, control, start);
+    }
     let mut film = match control.resume.take() {
         Some(IntegratorState::Film(film))
-            if (film.width as u32, film.height as u32) == ctx.resolution =>
+            if (film.width as u32, film.height as u32) == ctx.film_size() =>
         {
             Film {
                 sensor: ctx.sensor,
@@ -64,14 +71,8 @@ pub fn render_passes<E: PixelEstimator>(
         _ => ctx.new_film(),
     };
     let (w, h) = (film.width as u64, film.height as u64);
-    progress
-        .total
-        .store(w * h * ctx.spp as u64, Ordering::Relaxed);
-    let taken: u64 = film
-        .pixels
-        .iter()
-        .map(|p| p.samples.min(ctx.spp) as u64)
-        .sum();
+    progress.total.store(w * h * end as u64, Ordering::Relaxed);
+    let taken: u64 = film.pixels.iter().map(|p| p.samples.min(end) as u64).sum();
     progress.done.fetch_add(taken, Ordering::Relaxed);
     let mut spp_done = film.min_samples();
     // The pass schedule of a fresh render (1, 1, 2, 4, … 64, 64, …), picked up where a
@@ -79,10 +80,10 @@ pub fn render_passes<E: PixelEstimator>(
     let mut pass = if spp_done < 2 {
         1
     } else {
-        (1u32 << (31 - spp_done.leading_zeros())).min(64)
+        (1u32 << (31 - spp_done.leading_zeros())).min(SAMPLE_BLOCK)
     };
-    while spp_done < ctx.spp && !progress.cancelled() {
-        let mut n = pass.min(ctx.spp - spp_done);
+    while spp_done < end && !progress.cancelled() {
+        let mut n = pass.min(end - spp_done);
         if spp_done > 0 && !spp_done.is_power_of_two() {
             n = n.min(spp_done.next_power_of_two() - spp_done);
         }
@@ -97,7 +98,7 @@ pub fn render_passes<E: PixelEstimator>(
         }
         control.boundary(spp_done, &|| IntegratorState::Film(film.clone()));
         if spp_done >= 2 {
-            pass = (pass * 2).min(64);
+            pass = (pass * 2).min(SAMPLE_BLOCK);
         }
     }
     let interrupted = progress.cancelled();
@@ -109,11 +110,68 @@ pub fn render_passes<E: PixelEstimator>(
         rays: progress.rays.load(Ordering::Relaxed),
         interrupted,
         stats: Stats::default(),
+        blocks: Vec::new(),
     }
 }
 
+/// A sample range past the first block: each block into a film of its own (no
+/// snapshots or checkpoints: such a unit is rerun whole).
+fn render_blocks<E: PixelEstimator>(
+    ctx: &RenderContext,
+    estimator: &E,
+    control: &mut RenderControl<'_>,
+    start: Instant,
+) -> RenderOutput {
+    let progress = control.progress;
+    let (first, end) = ctx.work.samples;
+    let (w, h) = ctx.film_size();
+    progress.total.store(
+        w as u64 * h as u64 * (end - first) as u64,
+        Ordering::Relaxed,
+    );
+    let mut blocks = Vec::new();
+    let mut film = ctx.new_film();
+    let mut s = first;
+    while s < end && !progress.cancelled() {
+        let e = ((s / SAMPLE_BLOCK + 1) * SAMPLE_BLOCK).min(end);
+        let mut block = ctx.new_film();
+        block.nonfinite = render_pass(ctx, estimator, &mut block, s, e - s, progress);
+        if progress.cancelled() {
+            break;
+        }
+        for (p, b) in film.pixels.iter_mut().zip(&block.pixels) {
+            fold(p, b);
+        }
+        film.nonfinite.merge(block.nonfinite);
+        blocks.push(block);
+        s = e;
+    }
+    RenderOutput {
+        spp_done: film.min_samples(),
+        state: None,
+        film,
+        seconds: start.elapsed().as_secs_f64(),
+        rays: progress.rays.load(Ordering::Relaxed),
+        interrupted: progress.cancelled(),
+        stats: Stats::default(),
+        blocks,
+    }
+}
+
+/// Adds a block's sums to a pixel: the one step by which blocks are combined, on one
+/// machine and in a merge alike.
+pub fn fold(pixel: &mut FilmPixel, block: &FilmPixel) {
+    for (s, b) in pixel.sum.iter_mut().zip(block.sum) {
+        *s += b;
+    }
+    pixel.weight += block.weight;
+    pixel.samples += block.samples;
+}
+
 /// Adds samples `first .. first + count` to every pixel (those it does not have yet:
-/// a resumed film may hold some of them already).
+/// a resumed film may hold some of them already). Samples of the first block go
+/// straight into the pixel's sums; those of a later block are summed apart and folded
+/// in when the block (or the pass) ends.
 fn render_pass<E: PixelEstimator>(
     ctx: &RenderContext,
     estimator: &E,
@@ -123,35 +181,47 @@ fn render_pass<E: PixelEstimator>(
     progress: &Progress,
 ) -> NonFinite {
     let width = film.width;
+    let (x0, y0) = (ctx.work.pixels.x0, ctx.work.pixels.y0);
     film.pixels
         .par_chunks_mut(width)
         .enumerate()
-        .map(|(y, row)| {
+        .map(|(row_index, row)| {
             let mut nonfinite = NonFinite::default();
             if progress.cancelled() {
                 return nonfinite;
             }
+            let y = y0 + row_index as u32;
             let mut rays = 0u64;
             let mut row_samples = 0u64;
             let mut scratch = estimator.scratch();
-            for (x, film_pixel) in row.iter_mut().enumerate() {
-                for index in film_pixel.samples.max(first)..first + count {
-                    let pixel = PixelId {
-                        x: x as u32,
-                        y: y as u32,
-                        index,
-                    };
+            for (column, film_pixel) in row.iter_mut().enumerate() {
+                let x = x0 + column as u32;
+                let mut open = FilmPixel::default();
+                let last = first + count;
+                for index in film_pixel.samples.max(first)..last {
+                    let pixel = PixelId { x, y, index };
                     row_samples += 1;
                     let (l, weight, r) = sample_pixel(ctx, estimator, &mut scratch, pixel);
                     rays += r as u64;
-                    if l.is_finite() && weight.is_finite() {
-                        film_pixel.add(l, weight);
+                    let target = if index < SAMPLE_BLOCK {
+                        &mut *film_pixel
                     } else {
-                        film_pixel.samples += 1;
+                        &mut open
+                    };
+                    if l.is_finite() && weight.is_finite() {
+                        target.add(l, weight);
+                    } else {
+                        target.samples += 1;
                         nonfinite.merge(NonFinite {
                             count: 1,
                             first_pixel: Some((pixel.x, pixel.y)),
                         });
+                    }
+                    if index >= SAMPLE_BLOCK
+                        && ((index + 1) % SAMPLE_BLOCK == 0 || index + 1 == last)
+                    {
+                        fold(film_pixel, &open);
+                        open = FilmPixel::default();
                     }
                 }
             }

@@ -127,13 +127,18 @@ fn render(
 ) -> RenderOutput {
     let start = Instant::now();
     let progress = control.progress;
-    let (w, h) = (ctx.resolution.0 as usize, ctx.resolution.1 as usize);
+    // A work unit gathers into its own pixels only; the photon stream of every
+    // iteration is the whole image's, so each pixel sees the photons it would see in
+    // the full render, in the same order.
+    let (w, h) = (ctx.film_size().0 as usize, ctx.film_size().1 as usize);
+    let (x0, y0) = (ctx.work.pixels.x0, ctx.work.pixels.y0);
     let n_pix = w * h;
+    let full_pixels = ctx.resolution.0 as u64 * ctx.resolution.1 as u64;
     let seed = settings.seed.unwrap_or(ctx.seed);
     let radius = settings.radius.unwrap_or_else(|| default_radius(ctx));
     let n_photons = settings
         .photons_per_iteration
-        .map_or(n_pix as u64, u64::from)
+        .map_or(full_pixels, u64::from)
         .max(1);
     let mut stats = SppmStats {
         photons_per_iteration: n_photons,
@@ -150,7 +155,7 @@ fn render(
             width,
             height,
             pixels,
-        }) if (width, height) == ctx.resolution && pixels.len() == n_pix => (pixels, iterations),
+        }) if (width, height) == ctx.film_size() && pixels.len() == n_pix => (pixels, iterations),
         _ => (
             vec![
                 PixelState {
@@ -188,8 +193,8 @@ fn render(
                 ctx,
                 seed,
                 settings.max_depth,
-                (i % w) as u32,
-                (i / w) as u32,
+                x0 + (i % w) as u32,
+                y0 + (i / w) as u32,
                 it,
             );
         });
@@ -292,6 +297,10 @@ fn render(
     let mean_r2 = state.iter().map(|s| s.r2).sum::<f64>() / n_pix.max(1) as f64;
     stats.final_radius = mean_r2.sqrt() as f32;
     write_estimates(&mut film, &state, done, n_photons);
+    // Pixels are named in the full image's coordinates.
+    if let Some((x, y)) = film.nonfinite.first_pixel {
+        film.nonfinite.first_pixel = Some((x + x0, y + y0));
+    }
     let interrupted = done < ctx.spp;
     RenderOutput {
         state: control.final_state(|| snapshot_state(&state, done)),
@@ -301,6 +310,7 @@ fn render(
         spp_done: done,
         interrupted,
         stats: Stats::new(stats),
+        blocks: Vec::new(),
     }
 }
 
