@@ -109,6 +109,17 @@ struct Task {
     max_spp: u32,
 }
 
+impl Task {
+    /// What the snapshots count: samples per pixel, or SPPM's iterations.
+    fn unit(&self) -> &'static str {
+        if self.integrator == "sppm" {
+            "iterations"
+        } else {
+            "spp"
+        }
+    }
+}
+
 /// A convergence run: (spp, CPU seconds, relMSE) at every power-of-two snapshot.
 fn convergence(task: &Task, reference: &Image, seed: u64) -> anyhow::Result<Vec<(u32, f64, f64)>> {
     let start = cpu_seconds();
@@ -214,17 +225,19 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
                 continue;
             };
             cells.push(format!(
-                "seed {seed}: {t:.1} CPU-s at {n:.0} spp{}",
+                "seed {seed}: {t:.1} CPU-s at {n:.0} {}{}",
+                task.unit(),
                 if extrapolated { " (extrapolated)" } else { "" }
             ));
             times.push(t);
             spps.push(n);
         }
         println!(
-            "{}: median {:.1} CPU-s, {:.0} spp  [{}]",
+            "{}: median {:.1} CPU-s, {:.0} {}  [{}]",
             task.label,
             median(times),
             median(spps),
+            task.unit(),
             cells.join("; ")
         );
     }
