@@ -3,7 +3,7 @@
 //! light as a whole (a parallelogram when it is a quad), sampled with one 2D sample
 //! stratified over the whole emitter. Were each triangle its own light, a separate 1D
 //! choice among them would break the 2D stratification of the point on the emitter: on
-//! the Cornell box's quad light that costs 5.4× the direct-light variance of sampling
+//! the Cornell box's quad light that costs 3.2× the direct-light variance of sampling
 //! the quad as one patch.
 
 use glam::{Vec2, Vec3};
