@@ -27,8 +27,8 @@ use radiant_testkit::chi2::{ChiSquareReport, ChiSquareTest, Domain, DomainPoint,
 /// Family-wise significance of the whole file: each chi-square test is judged at
 /// Šidák's 1 - (1 - ALPHA)^(1 / CHI2_TESTS).
 const ALPHA: f64 = 0.01;
-/// Every chi-square test in this file: 18 of `sample_li`, 15 of `sample_le`.
-const CHI2_TESTS: u32 = 33;
+/// Every chi-square test in this file: 22 of `sample_li`, 15 of `sample_le`.
+const CHI2_TESTS: u32 = 37;
 const SAMPLES: u64 = 200_000;
 
 /// Passes unless the report fails at the file's family-wise significance; prints it.
@@ -77,8 +77,9 @@ fn triangle() -> Geometry {
     mesh(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![0, 1, 2])
 }
 
-/// A planar but irregular quad in z = 0 facing +z: the world makes two triangle lights
-/// of different areas of it, so its test also covers the light sampler's choice.
+/// A planar but irregular quad in z = 0 facing +z: two triangles of different areas that
+/// are no parallelogram, so the world makes one mesh light of them, and its test covers
+/// the choice of the triangle by area inside the light.
 fn planar_quad() -> Geometry {
     Geometry::BilinearMesh {
         positions: vec![
@@ -91,6 +92,32 @@ fn planar_quad() -> Geometry {
         normals: None,
         uvs: None,
     }
+}
+
+/// A tilted parallelogram (a quad of two triangles, as the Cornell box's light):
+/// sampled as one patch.
+fn parallelogram() -> Geometry {
+    let (p, e1, e2) = (
+        Vec3::new(-0.5, -0.3, 0.0),
+        Vec3::new(1.2, 0.2, 0.1),
+        Vec3::new(0.3, 0.9, -0.2),
+    );
+    mesh(vec![p, p + e1, p + e1 + e2, p + e2], vec![0, 1, 2, 0, 2, 3])
+}
+
+/// An open pyramid of four triangles over the unit square, apex at z = 0.7, facing out:
+/// a mesh light whose triangles face different ways.
+fn pyramid() -> Geometry {
+    mesh(
+        vec![
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+            Vec3::new(0.2, 0.1, 0.7),
+        ],
+        vec![0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4],
+    )
 }
 
 /// A saddle-shaped bilinear patch over [-1, 1]², heights 0 to 0.6, facing about +z.
@@ -261,9 +288,23 @@ fn triangle_light_sample_li_follows_pdf_li() {
 #[test]
 fn quad_and_bilinear_lights_sample_li_follow_pdf_li() {
     let quad = world_of(vec![emitter(planar_quad(), Transform::IDENTITY, false)]);
-    assert_eq!(quad.lights.len(), 2, "a planar quad is two triangle lights");
+    assert!(
+        matches!(&quad.lights[..], [Light::Area(a)] if matches!(a.shape, LightShape::Mesh(_))),
+        "an irregular planar quad is one mesh light"
+    );
     li("quad_near", &quad, Vec3::new(0.8, 0.5, 0.3), 5);
     li_grazing("quad_grazing", &quad, Vec3::new(-0.5, 0.5, 0.05), 6);
+    let par = world_of(vec![emitter(parallelogram(), Transform::IDENTITY, false)]);
+    assert!(
+        matches!(&par.lights[..], [Light::Area(a)] if matches!(a.shape, LightShape::Parallelogram { .. })),
+        "two triangles forming a parallelogram are one parallelogram light"
+    );
+    li("parallelogram_near", &par, Vec3::new(0.2, 0.3, 0.4), 38);
+    li_grazing("parallelogram_grazing", &par, Vec3::new(1.4, 0.4, 0.12), 39);
+    let pyr = world_of(vec![emitter(pyramid(), Transform::IDENTITY, false)]);
+    assert_eq!(pyr.lights.len(), 1, "a mesh is one light");
+    li("mesh_near", &pyr, Vec3::new(1.1, 0.6, 0.5), 40);
+    li_far("mesh_far", &pyr, Vec3::new(-0.8, 2.5, 4.0), 41);
     let patch = world_of(vec![emitter(saddle(), Transform::IDENTITY, false)]);
     assert!(matches!(
         &patch.lights[..],

@@ -17,7 +17,7 @@ mod tree;
 
 use glam::{Vec2, Vec3};
 
-pub use area::{AreaLight, LightShape};
+pub use area::{AreaLight, EmittingMesh, LightShape, parallelogram_of};
 pub use environment::{EnvironmentMap, EnvironmentPicture, rotation_of};
 pub use sampler::{
     LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, LightSampler, SampledLight, UnknownLightSampler,

@@ -170,3 +170,71 @@ fn emitted_power_equals_light_power() {
         );
     }
 }
+
+/// The corner form factor of the unit square at distance 1 (Howell, C-11), times π.
+fn unit_square_corner_irradiance() -> f64 {
+    let a = 1.0f64;
+    let f = 2.0 * (a / (1.0 + a * a).sqrt() * (a / (1.0 + a * a).sqrt()).atan())
+        / (2.0 * std::f64::consts::PI);
+    std::f64::consts::PI * f
+}
+
+#[test]
+fn parallelogram_and_mesh_lights_match_the_corner_form_factor() {
+    let Light::Area(AreaLight {
+        shape: LightShape::Triangle { p: a, .. },
+        ..
+    }) = square_light(1.0, 1.0, 1.0)[0].clone()
+    else {
+        unreachable!()
+    };
+    let Light::Area(AreaLight {
+        shape: LightShape::Triangle { p: b, .. },
+        ..
+    }) = square_light(1.0, 1.0, 1.0)[1].clone()
+    else {
+        unreachable!()
+    };
+    let (corner, e1, e2) = parallelogram_of(a, b).expect("the square's halves");
+    let light = |shape| {
+        Light::Area(AreaLight {
+            shape,
+            l: Rgb::splat(1.0),
+            two_sided: false,
+        })
+    };
+    let parallelogram = light(LightShape::Parallelogram {
+        p: corner,
+        e1,
+        e2,
+        n: -Vec3::Z,
+        area: e1.cross(e2).length(),
+    });
+    let mesh = light(LightShape::Mesh(Box::new(EmittingMesh::new(
+        vec![a, b],
+        vec![-Vec3::Z; 2],
+    ))));
+    let exact = unit_square_corner_irradiance();
+    for (name, l) in [("parallelogram", parallelogram), ("mesh", mesh)] {
+        let (e, se) = irradiance(&l, Vec3::ZERO, Vec3::Z, 100_000);
+        assert!(
+            (e - exact).abs() < 4.0 * se + 1e-6,
+            "{name}: {e} vs {exact} (se {se})"
+        );
+    }
+}
+
+#[test]
+fn only_two_triangles_that_mirror_through_a_shared_diagonal_are_a_parallelogram() {
+    let [o, x, y, xy] = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.3, 1.0, 0.0)];
+    // A parallelogram (o, x, x + y', y') with y' = (0.3, 1, 0), in either winding.
+    let y2 = xy - x;
+    let (c, e1, e2) = parallelogram_of([o, x, xy], [o, xy, y2]).expect("a parallelogram");
+    // Corner at the unshared vertex x, the opposite corner y2, area |x × y2| = 1.
+    assert!((c + e1 + e2 - y2).length() < 1e-6 && (e1.cross(e2).length() - 1.0).abs() < 1e-6);
+    assert!(parallelogram_of([x, xy, o], [y2, o, xy]).is_some());
+    // The same diagonal but the fourth corner off the mirror point: no parallelogram.
+    assert_eq!(parallelogram_of([o, x, xy], [o, xy, y]), None);
+    // Sharing one vertex only.
+    assert_eq!(parallelogram_of([o, x, y], [o, xy, y2 + Vec3::Z]), None);
+}

@@ -12,8 +12,9 @@ use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
 use crate::light::{
-    AreaLight, EnvironmentMap, EnvironmentPicture, LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, Light,
-    LightSampler, LightShape, SceneSphere, rotation_of,
+    AreaLight, EmittingMesh, EnvironmentMap, EnvironmentPicture, LIGHT_SAMPLER_NAMES,
+    LIGHT_SAMPLER_PARAM, Light, LightSampler, LightShape, SceneSphere, parallelogram_of,
+    rotation_of,
 };
 use crate::material::Material;
 use crate::texture::{TextureSet, concrete_material};
@@ -558,6 +559,59 @@ fn push_light(lights: &mut Vec<Light>, a: &AreaLightDesc, shape: LightShape) -> 
     (lights.len() - 1) as u32
 }
 
+/// The light of an emitting triangle mesh (render-space vertices `p`): one triangle, a
+/// parallelogram for two that form one, else the whole mesh; `None` when no triangle
+/// has an area. With shading normals a triangle's front follows them (pbrt-v4), else
+/// the winding times `orientation`.
+fn emitting_mesh(
+    p: &[Vec3],
+    indices: &[u32],
+    normals: Option<&[Vec3]>,
+    orientation: f32,
+) -> Option<LightShape> {
+    let mut triangles = Vec::new();
+    let mut fronts = Vec::new();
+    for tri in indices.chunks_exact(3) {
+        let v = [tri[0], tri[1], tri[2]].map(|i| i as usize);
+        let pts = v.map(|i| p[i]);
+        let cross = (pts[1] - pts[0]).cross(pts[2] - pts[0]);
+        if cross.length() == 0.0 {
+            continue;
+        }
+        let mut front = cross.normalize();
+        match normals {
+            Some(ns) if (ns[v[0]] + ns[v[1]] + ns[v[2]]).dot(front) < 0.0 => front = -front,
+            Some(_) => {}
+            None => front *= orientation,
+        }
+        triangles.push(pts);
+        fronts.push(front);
+    }
+    match (&triangles[..], &fronts[..]) {
+        ([], _) => None,
+        ([t], [n]) => Some(LightShape::Triangle {
+            p: *t,
+            n: *n,
+            area: 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length(),
+        }),
+        ([a, b], [na, nb]) if na.dot(*nb) > 1.0 - 1e-6 => match parallelogram_of(*a, *b) {
+            Some((corner, e1, e2)) => Some(LightShape::Parallelogram {
+                p: corner,
+                e1,
+                e2,
+                n: *na,
+                area: e1.cross(e2).length(),
+            }),
+            None => Some(LightShape::Mesh(Box::new(EmittingMesh::new(
+                triangles, fronts,
+            )))),
+        },
+        _ => Some(LightShape::Mesh(Box::new(EmittingMesh::new(
+            triangles, fronts,
+        )))),
+    }
+}
+
 fn add_mesh(
     set: &mut ShapeSet,
     shape: &ShapeDesc,
@@ -585,38 +639,17 @@ fn add_mesh(
             .collect()
     });
     let mesh = set.meshes.len() as u32;
+    let light = match &mut emission {
+        None => NO_LIGHT,
+        Some((a, lights)) => emitting_mesh(&p, &indices, n.as_deref(), orientation)
+            .map_or(NO_LIGHT, |shape| push_light(lights, a, shape)),
+    };
     for (k, tri) in indices.chunks_exact(3).enumerate() {
-        let v = [tri[0], tri[1], tri[2]].map(|i| i as usize);
-        let pts = v.map(|i| p[i]);
-        let light = match &mut emission {
-            None => NO_LIGHT,
-            Some((a, lights)) => {
-                let cross = (pts[1] - pts[0]).cross(pts[2] - pts[0]);
-                let area = 0.5 * cross.length();
-                if area > 0.0 {
-                    // With shading normals the front follows them (pbrt-v4), else the winding.
-                    let mut front = cross.normalize();
-                    match &n {
-                        Some(ns) if (ns[v[0]] + ns[v[1]] + ns[v[2]]).dot(front) < 0.0 => {
-                            front = -front
-                        }
-                        Some(_) => {}
-                        None => front *= orientation,
-                    }
-                    push_light(
-                        lights,
-                        a,
-                        LightShape::Triangle {
-                            p: pts,
-                            n: front,
-                            area,
-                        },
-                    )
-                } else {
-                    NO_LIGHT
-                }
-            }
-        };
+        let pts = [tri[0], tri[1], tri[2]].map(|i| p[i as usize]);
+        // Degenerate triangles carry no light (no area to sample), as the mesh light
+        // leaves them out.
+        let degenerate = (pts[1] - pts[0]).cross(pts[2] - pts[0]).length() == 0.0;
+        let light = if degenerate { NO_LIGHT } else { light };
         set.triangles.push(pts);
         set.triangle_attrs.push(TriangleAttr {
             mesh,

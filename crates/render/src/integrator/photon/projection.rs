@@ -174,7 +174,10 @@ fn resolution(light: &Light) -> (u32, u32) {
     match light {
         Light::Point { .. } | Light::Spot { .. } => (1, DIR_RES),
         Light::Area(a) => match a.shape {
-            LightShape::Triangle { .. } | LightShape::Disk { .. } => (AREA_POS_RES, DIR_RES),
+            LightShape::Triangle { .. }
+            | LightShape::Parallelogram { .. }
+            | LightShape::Mesh(_)
+            | LightShape::Disk { .. } => (AREA_POS_RES, DIR_RES),
             LightShape::Sphere { .. } | LightShape::Bilinear { .. } => (1, 1),
         },
         Light::Distant { .. } => (DISTANT_POS_RES, 1),
