@@ -365,6 +365,23 @@ fn light_bounds(light: &Light, scene: SceneSphere) -> Option<LightBounds> {
         Light::Area(area) => {
             let (bounds, normals) = match &area.shape {
                 LightShape::Triangle { p, n, .. } => (Aabb::from_points(p), Cone::around(*n)),
+                LightShape::Parallelogram { p, e1, e2, n, .. } => (
+                    Aabb::from_points(&[*p, *p + *e1, *p + *e2, *p + *e1 + *e2]),
+                    Cone::around(*n),
+                ),
+                LightShape::Mesh(mesh) => {
+                    let bounds = mesh
+                        .triangles
+                        .iter()
+                        .fold(Aabb::default(), |b, t| b.union(&Aabb::from_points(t)));
+                    let normals = mesh
+                        .normals
+                        .iter()
+                        .map(|&n| Cone::around(n))
+                        .reduce(Cone::union)
+                        .unwrap_or(Cone::EVERYWHERE);
+                    (bounds, normals)
+                }
                 LightShape::Sphere {
                     sphere,
                     render_from_object,
