@@ -3,11 +3,12 @@
 mod bench_cmd;
 mod compare_cmd;
 mod lens_cmd;
+mod pbrt_opts;
 mod radiosity_cmd;
 mod render_cmd;
 mod signals;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
 #[derive(Parser)]
 #[command(
@@ -35,8 +36,27 @@ enum Command {
     Radiosity(radiosity_cmd::RadiosityArgs),
 }
 
+/// pbrt's habit `radiant scene.pbrt [more.pbrt …] [flags]`: when the first argument
+/// is neither a subcommand nor a top-level flag (help, version), the arguments are
+/// `render`'s. A scene file named like a subcommand is reached as `./render`.
+fn with_default_subcommand(mut args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
+    let Some(first) = args.get(1).and_then(|a| a.to_str()) else {
+        return args;
+    };
+    let cmd = Cli::command();
+    let is_subcommand = first == "help"
+        || cmd
+            .get_subcommands()
+            .any(|c| c.get_name() == first || c.get_all_aliases().any(|a| a == first));
+    let top_level_flag = matches!(first, "-h" | "--help" | "-V" | "--version");
+    if !is_subcommand && !top_level_flag {
+        args.insert(1, "render".into());
+    }
+    args
+}
+
 fn main() {
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(with_default_subcommand(std::env::args_os().collect()));
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(args),
         Command::Compare(args) => compare_cmd::run(args),

@@ -151,8 +151,12 @@ impl RenderContext {
         let fs = self.filter.sample(sampler.get_2d());
         let raster = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + fs.offset;
         let u_lens = sampler.get_2d();
+        let ray = self.camera.generate_ray(raster, u_lens);
+        if ray.is_some() {
+            crate::stats::add(crate::stats::Counter::CameraRays, 1);
+        }
         CameraSample {
-            ray: self.camera.generate_ray(raster, u_lens),
+            ray,
             filter_weight: fs.weight,
         }
     }

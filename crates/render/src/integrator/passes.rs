@@ -92,6 +92,7 @@ pub fn render_passes<E: PixelEstimator>(
             break;
         }
         spp_done += n;
+        control.after_pass(spp_done, &film);
         if spp_done.is_power_of_two() {
             (control.snapshot)(spp_done, &film);
         }

@@ -282,8 +282,12 @@ fn render(
             .fetch_add(camera_rays + photon_rays, Ordering::Relaxed);
         progress.done.fetch_add(n_pix as u64, Ordering::Relaxed);
         done = it + 1;
-        if done.is_power_of_two() {
+        let snapshot = done.is_power_of_two();
+        if snapshot || control.watches_passes() {
             write_estimates(&mut film, &state, done, n_photons);
+            control.after_pass(done, &film);
+        }
+        if snapshot {
             (control.snapshot)(done, &film);
         }
         control.boundary(done, &|| snapshot_state(&state, done));
