@@ -128,9 +128,8 @@ impl PassWatchers {
     ) -> anyhow::Result<PassWatchers> {
         let mse = match (&args.mse_reference_image, &args.mse_reference_out) {
             (Some(reference), Some(out)) => {
-                let image = radiant::image::read_image(reference).with_context(|| {
-                    format!("--mse-reference-image {}", reference.display())
-                })?;
+                let image = radiant::image::read_image(reference)
+                    .with_context(|| format!("--mse-reference-image {}", reference.display()))?;
                 if (image.width as u32, image.height as u32) != resolution {
                     bail!(
                         "--mse-reference-image {}: {}x{}, the render is {}x{}",
@@ -262,7 +261,11 @@ pub struct MemoryUse {
 const BYTES_PER_PRIMITIVE: f64 = 150.0;
 
 impl MemoryUse {
-    pub fn of(session: &radiant::Session, out: &radiant::render::RenderOutput, aov_channels: usize) -> MemoryUse {
+    pub fn of(
+        session: &radiant::Session,
+        out: &radiant::render::RenderOutput,
+        aov_channels: usize,
+    ) -> MemoryUse {
         use radiant::render::integrator::PhotonMapStats;
         let pixels = out.film.pixels.len() as f64;
         let photons = out
@@ -343,7 +346,10 @@ pub fn format_stats(
         "Time",
         vec![
             ("Scene parsing", format!("{:.3} s", times.parse)),
-            ("Scene building (BVH, lights)", format!("{:.3} s", times.build)),
+            (
+                "Scene building (BVH, lights)",
+                format!("{:.3} s", times.build),
+            ),
             ("Rendering", format!("{:.3} s", times.render)),
             ("AOV pass", format!("{:.3} s", times.aov)),
             ("Image writing", format!("{:.3} s", times.write)),

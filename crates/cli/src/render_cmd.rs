@@ -247,7 +247,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if desc.film.gbuffer.is_some() {
         aovs = radiant::render::aov::AovSet::ALL;
     }
-    if aovs.any() && radiant::image::Format::from_path(&output).ok() != Some(radiant::image::Format::Exr) {
+    if aovs.any()
+        && radiant::image::Format::from_path(&output).ok() != Some(radiant::image::Format::Exr)
+    {
         bail!(
             "{}: AOV channels (--aov, Film \"gbuffer\") need an EXR output",
             output.display()
@@ -257,10 +259,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         spp: if args.pbrt.quick { Some(1) } else { args.spp },
         seed: args.seed,
         resolution: if args.pbrt.quick {
-            Some(args.pbrt.quick_resolution(
-                args.resolution
-                    .unwrap_or((desc.film.xresolution, desc.film.yresolution)),
-            ))
+            Some(
+                args.pbrt.quick_resolution(
+                    args.resolution
+                        .unwrap_or((desc.film.xresolution, desc.film.yresolution)),
+                ),
+            )
         } else {
             args.resolution
         },
@@ -472,7 +476,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
 
 /// Channels the AOV set writes.
 fn aovs_channel_count(set: radiant::render::aov::AovSet) -> usize {
-    3 * (set.albedo as usize + set.position as usize + set.normal as usize + set.shading_normal as usize)
+    3 * (set.albedo as usize
+        + set.position as usize
+        + set.normal as usize
+        + set.shading_normal as usize)
         + set.depth as usize
 }
 

@@ -65,7 +65,9 @@ fn a_scene_file_renders_without_a_subcommand() {
     let scene = write_scene(
         &dir,
         "wall.pbrt",
-        &format!("Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 12\n{WALL_OPTIONS}{WALL_WORLD}"),
+        &format!(
+            "Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 12\n{WALL_OPTIONS}{WALL_WORLD}"
+        ),
     );
     let out = dir.join("x.exr");
     ok(radiant()
@@ -93,7 +95,9 @@ fn several_files_are_read_as_one_scene_with_their_own_locations() {
     let a = write_scene(
         &dir,
         "a.pbrt",
-        &format!("Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n{WALL_OPTIONS}"),
+        &format!(
+            "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n{WALL_OPTIONS}"
+        ),
     );
     let b = write_scene(&dir, "b.pbrt", WALL_WORLD);
     let out = dir.join("ab.exr");
@@ -122,7 +126,15 @@ fn quick_quarters_the_resolution_and_takes_one_sample() {
     let dir = temp_dir("quick");
     let out = dir.join("q.exr");
     ok(radiant()
-        .args(["cornell-box", "--quick", "--spp", "64", "--resolution", "40x32", "-o"])
+        .args([
+            "cornell-box",
+            "--quick",
+            "--spp",
+            "64",
+            "--resolution",
+            "40x32",
+            "-o",
+        ])
         .arg(&out));
     let img = read_image(&out).unwrap();
     assert_eq!((img.width, img.height), (10, 8));
@@ -138,7 +150,9 @@ fn log_levels_choose_the_messages() {
     let scene = write_scene(
         &dir,
         "warn.pbrt",
-        &format!("Film \"spectral\" \"integer xresolution\" 8 \"integer yresolution\" 8\n{WALL_OPTIONS}{WALL_WORLD}"),
+        &format!(
+            "Film \"spectral\" \"integer xresolution\" 8 \"integer yresolution\" 8\n{WALL_OPTIONS}{WALL_WORLD}"
+        ),
     );
     let stderr = |level: &str| {
         let out = ok(radiant()
@@ -152,7 +166,10 @@ fn log_levels_choose_the_messages() {
     let fatal = stderr("fatal");
     assert!(verbose.contains("pass done: 4 spp"), "{verbose}");
     assert!(verbose.contains("Film \"spectral\""), "{verbose}");
-    assert!(error.contains("Film \"spectral\"") && !error.contains("pass done"), "{error}");
+    assert!(
+        error.contains("Film \"spectral\"") && !error.contains("pass done"),
+        "{error}"
+    );
     assert!(fatal.trim().is_empty(), "{fatal}");
 }
 
@@ -189,11 +206,26 @@ fn mse_reference_output_has_pbrts_format_and_falls() {
     let dir = temp_dir("mse");
     let reference = dir.join("ref.exr");
     ok(radiant()
-        .args(["cornell-box", "--spp", "256", "--resolution", "16x16", "--quiet", "-o"])
+        .args([
+            "cornell-box",
+            "--spp",
+            "256",
+            "--resolution",
+            "16x16",
+            "--quiet",
+            "-o",
+        ])
         .arg(&reference));
     let mse_path = dir.join("mse.txt");
     ok(radiant()
-        .args(["cornell-box", "--spp", "64", "--resolution", "16x16", "--quiet"])
+        .args([
+            "cornell-box",
+            "--spp",
+            "64",
+            "--resolution",
+            "16x16",
+            "--quiet",
+        ])
         .arg("--mse-reference-image")
         .arg(&reference)
         .arg("--mse-reference-out")
@@ -229,7 +261,11 @@ fn mse_reference_output_has_pbrts_format_and_falls() {
         })
         .sum::<f64>()
         / (3.0 * test.pixels.len() as f64);
-    assert!((rows[6].1 - mse).abs() <= 1e-6 * mse, "{} vs {mse}", rows[6].1);
+    assert!(
+        (rows[6].1 - mse).abs() <= 1e-6 * mse,
+        "{} vs {mse}",
+        rows[6].1
+    );
 }
 
 #[test]
@@ -237,7 +273,15 @@ fn stats_count_rays_by_kind_and_leave_the_image_alone() {
     let dir = temp_dir("stats");
     let plain = dir.join("plain.exr");
     let counted = dir.join("counted.exr");
-    let args = ["cornell-box", "--spp", "4", "--resolution", "16x16", "--quiet", "-o"];
+    let args = [
+        "cornell-box",
+        "--spp",
+        "4",
+        "--resolution",
+        "16x16",
+        "--quiet",
+        "-o",
+    ];
     ok(radiant().args(args).arg(&plain));
     let out = ok(radiant().args(args).arg(&counted).arg("--stats"));
     assert_eq!(
@@ -254,7 +298,10 @@ fn stats_count_rays_by_kind_and_leave_the_image_alone() {
     };
     // One camera ray per pixel sample (the pinhole always makes one).
     assert_eq!(value("Camera rays"), 16 * 16 * 4, "{stdout}");
-    assert!(value("Indirect rays") > 0 && value("Shadow rays") > 0, "{stdout}");
+    assert!(
+        value("Indirect rays") > 0 && value("Shadow rays") > 0,
+        "{stdout}"
+    );
     assert_eq!(value("Photon rays"), 0, "{stdout}");
     assert_eq!(
         value("Closest-hit tests"),
@@ -266,7 +313,18 @@ fn stats_count_rays_by_kind_and_leave_the_image_alone() {
     }
     // Photon mapping reports its photons.
     let out = ok(radiant()
-        .args(["cornell-box", "--integrator", "photonmap", "--spp", "1", "--resolution", "8x8", "--quiet", "--stats", "-o"])
+        .args([
+            "cornell-box",
+            "--integrator",
+            "photonmap",
+            "--spp",
+            "1",
+            "--resolution",
+            "8x8",
+            "--quiet",
+            "--stats",
+            "-o",
+        ])
         .arg(dir.join("pm.exr")));
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("Photons stored"), "{stdout}");
@@ -307,7 +365,14 @@ fn display_server_streams_the_render_to_tev() {
     let server = std::thread::spawn(move || record_tev(listener));
     let out_path = dir.join("live.exr");
     ok(radiant()
-        .args(["cornell-box", "--spp", "4", "--resolution", "40x24", "--quiet"])
+        .args([
+            "cornell-box",
+            "--spp",
+            "4",
+            "--resolution",
+            "40x24",
+            "--quiet",
+        ])
         .args(["--display-server", &addr, "-o"])
         .arg(&out_path));
     let packets = server.join().unwrap();
@@ -382,7 +447,14 @@ fn a_viewer_that_goes_away_does_not_stop_the_render() {
     });
     let out_path = dir.join("gone.exr");
     ok(radiant()
-        .args(["cornell-box", "--spp", "16", "--resolution", "64x64", "--quiet"])
+        .args([
+            "cornell-box",
+            "--spp",
+            "16",
+            "--resolution",
+            "64x64",
+            "--quiet",
+        ])
         .args(["--display-server", &addr, "-o"])
         .arg(&out_path));
     server.join().unwrap();
@@ -447,13 +519,23 @@ fn aov_flag_adds_the_channels_asked_for_to_any_film() {
     let dir = temp_dir("aov");
     let out = dir.join("c.exr");
     ok(radiant()
-        .args(["cornell-box", "--spp", "4", "--resolution", "16x16", "--quiet"])
+        .args([
+            "cornell-box",
+            "--spp",
+            "4",
+            "--resolution",
+            "16x16",
+            "--quiet",
+        ])
         .args(["--aov", "albedo,depth", "-o"])
         .arg(&out));
     let ch = exr_channels(&out);
     let mut names: Vec<&str> = ch.keys().map(String::as_str).collect();
     names.sort();
-    assert_eq!(names, ["Albedo.B", "Albedo.G", "Albedo.R", "B", "G", "R", "Z"]);
+    assert_eq!(
+        names,
+        ["Albedo.B", "Albedo.G", "Albedo.R", "B", "G", "R", "Z"]
+    );
     // The Cornell box's walls and blocks are diffuse with reflectances below one, and
     // the camera sees something in every pixel.
     assert!(ch["Albedo.G"].iter().all(|&a| a > 0.0 && a < 1.0));
@@ -461,7 +543,15 @@ fn aov_flag_adds_the_channels_asked_for_to_any_film() {
     // The image is the one rendered without AOVs.
     let plain = dir.join("plain.exr");
     ok(radiant()
-        .args(["cornell-box", "--spp", "4", "--resolution", "16x16", "--quiet", "-o"])
+        .args([
+            "cornell-box",
+            "--spp",
+            "4",
+            "--resolution",
+            "16x16",
+            "--quiet",
+            "-o",
+        ])
         .arg(&plain));
     assert_eq!(
         read_image(&plain).unwrap().pixels,

@@ -120,8 +120,7 @@ pub fn write_exr_channels(
     let n = image.width * image.height;
     let mut names = std::collections::HashSet::new();
     for (name, values) in extra {
-        if values.len() != n || matches!(name.as_str(), "R" | "G" | "B") || !names.insert(name)
-        {
+        if values.len() != n || matches!(name.as_str(), "R" | "G" | "B") || !names.insert(name) {
             return Err(ImageError::Channels {
                 path: path.to_path_buf(),
                 message: format!(
@@ -165,7 +164,10 @@ pub fn write_exr_channels(
             path: path.to_path_buf(),
             message: format!("channel name {name:?} is not Latin-1 text"),
         })?;
-        channels.push(x::AnyChannel::new(text, x::FlatSamples::F32(values.clone())));
+        channels.push(x::AnyChannel::new(
+            text,
+            x::FlatSamples::F32(values.clone()),
+        ));
     }
     let layer = x::Layer::new(
         (image.width, image.height),

@@ -2,7 +2,7 @@
 //! integrator it names (or the command line names).
 
 use radiant_image::Film;
-use radiant_render::integrator::{CheckpointHook, IntegratorState};
+use radiant_render::integrator::{CheckpointHook, IntegratorState, PassWatch};
 use radiant_render::{Integrator, Overrides, Progress, RenderContext, RenderControl, RenderOutput};
 use radiant_scene::{SceneDesc, SceneError, Warning};
 
@@ -98,7 +98,7 @@ impl Session {
         snapshot: &'a mut dyn FnMut(u32, &Film),
         resume: Option<IntegratorState>,
         checkpoint: Option<&'a mut CheckpointHook<'a>>,
-        pass: Option<&'a mut dyn FnMut(u32, &Film)>,
+        pass: Option<&'a mut PassWatch<'a>>,
     ) -> Result<RenderOutput, CheckpointError> {
         if let Some(state) = &resume {
             let wanted = self.integrator.state_kind();

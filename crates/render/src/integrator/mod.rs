@@ -54,6 +54,9 @@ pub trait Integrator: Any + Send + Sync {
     }
 }
 
+/// Sees the film after a pass with the samples per pixel done ([`RenderControl::pass`]).
+pub type PassWatch<'a> = dyn FnMut(u32, &Film) + 'a;
+
 /// What a running render reports to, and is stopped by.
 pub struct RenderControl<'a> {
     pub progress: &'a Progress,
@@ -68,7 +71,7 @@ pub struct RenderControl<'a> {
     pub checkpoint: Option<&'a mut CheckpointHook<'a>>,
     /// Sees the film after every pass (SPPM: iteration) with the samples per pixel
     /// done: live views, partial images, error curves.
-    pub pass: Option<&'a mut dyn FnMut(u32, &Film)>,
+    pub pass: Option<&'a mut PassWatch<'a>>,
 }
 
 impl<'a> RenderControl<'a> {

@@ -57,8 +57,9 @@ pub fn parse_files(paths: &[PathBuf]) -> Result<SceneDesc, SceneError> {
         return parse_file(first);
     }
     let read = |path: &PathBuf| {
-        read_text(path)
-            .map_err(|e| e.into_error(|m| SceneError::file(path, format!("cannot read scene: {m}"))))
+        read_text(path).map_err(|e| {
+            e.into_error(|m| SceneError::file(path, format!("cannot read scene: {m}")))
+        })
     };
     let text = read(first)?;
     let base_dir = first.parent().map(Path::to_path_buf).unwrap_or_default();

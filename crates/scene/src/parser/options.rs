@@ -109,17 +109,24 @@ impl Parser {
         match name.as_str() {
             "rgb" => {}
             "gbuffer" => {
-                gbuffer = Some(match ps.string("coordinatesystem", "camera".into())?.as_str() {
-                    "camera" => GBufferSpace::Camera,
-                    "world" => GBufferSpace::World,
-                    other => {
-                        let at = ps.lookup("coordinatesystem").map_or(loc, |p| &p.loc).clone();
-                        return Err(SceneError::at(
-                            &at,
-                            format!("coordinatesystem \"{other}\": expected \"camera\" or \"world\""),
-                        ));
-                    }
-                });
+                gbuffer = Some(
+                    match ps.string("coordinatesystem", "camera".into())?.as_str() {
+                        "camera" => GBufferSpace::Camera,
+                        "world" => GBufferSpace::World,
+                        other => {
+                            let at = ps
+                                .lookup("coordinatesystem")
+                                .map_or(loc, |p| &p.loc)
+                                .clone();
+                            return Err(SceneError::at(
+                                &at,
+                                format!(
+                                    "coordinatesystem \"{other}\": expected \"camera\" or \"world\""
+                                ),
+                            ));
+                        }
+                    },
+                );
             }
             "spectral" => {
                 ps.lookup("coordinatesystem");
