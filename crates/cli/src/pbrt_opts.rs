@@ -40,6 +40,8 @@ pub enum AovName {
     Position,
     /// Z: the first hit's camera-space depth.
     Depth,
+    /// Variance.R/G/B: the variance of the pixel's samples (pass-loop integrators).
+    Variance,
 }
 
 /// The pbrt-v4 flags of `radiant render`.
@@ -72,15 +74,21 @@ pub struct PbrtArgs {
     /// pass); the render goes on if tev is not there or goes away.
     #[arg(long, value_name = "HOST:PORT")]
     pub display_server: Option<String>,
-    /// Extra EXR channels from the camera rays' first hits, averaged over the pixel's
-    /// first (up to 64) samples with the filter's weights: albedo, normal,
-    /// shading-normal, position, depth (`Film "gbuffer"` asks for all of them).
+    /// Extra EXR channels: from the camera rays' first hits, averaged over the pixel's
+    /// first (up to 64) samples with the filter's weights, albedo, normal,
+    /// shading-normal, position, depth; and the samples' variance (`Film "gbuffer"`
+    /// asks for all of them).
     #[arg(long, value_enum, value_delimiter = ',', value_name = "LIST")]
     pub aov: Vec<AovName>,
 }
 
 impl PbrtArgs {
-    /// The channels asked for by `--aov` (the film may add more).
+    /// True when `--aov` asks for the variance channels.
+    pub fn wants_variance(&self) -> bool {
+        self.aov.contains(&AovName::Variance)
+    }
+
+    /// The first-hit channels asked for by `--aov` (the film may add more).
     pub fn aov_set(&self) -> AovSet {
         let mut set = AovSet::default();
         for a in &self.aov {
@@ -90,6 +98,7 @@ impl PbrtArgs {
                 AovName::ShadingNormal => set.shading_normal = true,
                 AovName::Position => set.position = true,
                 AovName::Depth => set.depth = true,
+                AovName::Variance => {}
             }
         }
         set

@@ -244,10 +244,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         check_output(&output)?;
     }
     let mut aovs = args.pbrt.aov_set();
+    let variance = args.pbrt.wants_variance() || desc.film.gbuffer.is_some();
     if desc.film.gbuffer.is_some() {
         aovs = radiant::render::aov::AovSet::ALL;
     }
-    if aovs.any()
+    if (aovs.any() || variance)
         && radiant::image::Format::from_path(&output).ok() != Some(radiant::image::Format::Exr)
     {
         bail!(
@@ -271,7 +272,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         integrator: args.integrator.clone(),
     };
     let phase = std::time::Instant::now();
-    let session = Session::new(&desc, &overrides)?;
+    let mut session = Session::new(&desc, &overrides)?;
+    session.ctx.moments = variance;
     times.build = phase.elapsed().as_secs_f64();
     if warn {
         for w in &session.warnings {
@@ -405,6 +407,27 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     } else {
         Vec::new()
     };
+    let mut channels = channels;
+    if variance {
+        match output_data.film.variance() {
+            Some(v) => {
+                for (name, values) in ["Variance.R", "Variance.G", "Variance.B"]
+                    .into_iter()
+                    .zip(v)
+                {
+                    channels.push(radiant::render::aov::Channel {
+                        name: name.into(),
+                        values,
+                    });
+                }
+            }
+            None if warn => eprintln!(
+                "warning: no variance channels: the {} integrator (or a resumed render) keeps no per-sample moments",
+                session.integrator.name()
+            ),
+            None => {}
+        }
+    }
     times.aov = phase.elapsed().as_secs_f64();
     let meta = ImageMeta {
         samples_per_pixel: Some(output_data.spp_done),
@@ -430,7 +453,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         eprintln!("warning: {e}");
     }
     if args.pbrt.stats {
-        let memory = MemoryUse::of(&session, &output_data, aovs_channel_count(aovs));
+        let memory = MemoryUse::of(
+            &session,
+            &output_data,
+            aovs_channel_count(aovs) + 3 * variance as usize,
+        );
         let photons = output_data
             .stats
             .get::<radiant::render::integrator::PhotonMapStats>()

@@ -489,8 +489,25 @@ fn gbuffer_film_writes_albedo_normals_position_and_depth() {
     assert_eq!(
         names,
         [
-            "Albedo.B", "Albedo.G", "Albedo.R", "B", "G", "N.X", "N.Y", "N.Z", "Ns.X", "Ns.Y",
-            "Ns.Z", "P.X", "P.Y", "P.Z", "R", "Z"
+            "Albedo.B",
+            "Albedo.G",
+            "Albedo.R",
+            "B",
+            "G",
+            "N.X",
+            "N.Y",
+            "N.Z",
+            "Ns.X",
+            "Ns.Y",
+            "Ns.Z",
+            "P.X",
+            "P.Y",
+            "P.Z",
+            "R",
+            "Variance.B",
+            "Variance.G",
+            "Variance.R",
+            "Z"
         ]
     );
     let all = |name: &str, want: f32| {
@@ -511,7 +528,62 @@ fn gbuffer_film_writes_albedo_normals_position_and_depth() {
     all("P.Z", 5.0);
     all("Z", 5.0);
     // The image itself is still read as R, G, B.
-    assert!(read_image(&out).unwrap().mean() > 0.0);
+    let image = read_image(&out).unwrap();
+    assert!(image.mean() > 0.0);
+    for (i, v) in ch["Variance.G"].iter().enumerate() {
+        assert!(v.is_finite() && *v >= 0.0, "Variance.G[{i}] = {v}");
+    }
+}
+
+#[test]
+fn variance_channels_match_the_spread_of_independent_renders() {
+    // The variance channel of a 64-spp render estimates each pixel's per-sample
+    // variance; two 1-spp renders with other seeds are two independent samples per
+    // pixel, so over the image half their mean squared difference estimates the same
+    // mean variance (E[(a-b)^2] = 2 Var). 1024 pixels: agreement within a factor 2.
+    let dir = temp_dir("variance");
+    let render = |seed: &str, spp: &str, extra: &[&str], name: &str| {
+        let p = dir.join(name);
+        ok(radiant()
+            .args(["cornell-box", "--resolution", "32x32", "--quiet"])
+            .args(["--seed", seed, "--spp", spp])
+            .args(extra)
+            .arg("-o")
+            .arg(&p));
+        p
+    };
+    let v = render("1", "64", &["--aov", "variance"], "v.exr");
+    let ch = exr_channels(&v);
+    let g = &ch["Variance.G"];
+    let var_mean = g.iter().map(|&x| x as f64).sum::<f64>() / g.len() as f64;
+    let a = read_image(render("2", "1", &[], "a.exr")).unwrap();
+    let b = read_image(render("3", "1", &[], "b.exr")).unwrap();
+    let half_msd: f64 = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .map(|(x, y)| ((x.g - y.g) as f64).powi(2))
+        .sum::<f64>()
+        / (2.0 * a.pixels.len() as f64);
+    let ratio = var_mean / half_msd;
+    assert!(
+        (0.5..2.0).contains(&ratio),
+        "variance {var_mean} vs spread {half_msd}"
+    );
+    // SPPM keeps no per-sample moments: a warning, no channels.
+    let out = ok(radiant()
+        .args([
+            "cornell-box",
+            "--integrator",
+            "sppm",
+            "--spp",
+            "1",
+            "--resolution",
+            "8x8",
+        ])
+        .args(["--aov", "variance", "-o"])
+        .arg(dir.join("s.exr")));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no variance channels"));
 }
 
 #[test]

@@ -55,6 +55,8 @@ pub struct RenderContext {
     pub resolution: (u32, u32),
     /// Samples per pixel (SPPM: iterations).
     pub spp: u32,
+    /// Films keep second moments for a variance channel (pass-loop integrators).
+    pub moments: bool,
 }
 
 /// One pixel sample's camera ray.
@@ -127,17 +129,23 @@ impl RenderContext {
             sensor: Sensor::new(desc.film.iso, 1.0),
             resolution,
             spp: overrides.spp.unwrap_or(desc.sampler.pixel_samples).max(1),
+            moments: false,
         };
         Ok((context, warnings))
     }
 
     /// An empty film of the image's size, recording through the scene's sensor.
     pub fn new_film(&self) -> Film {
-        Film::new(
+        let film = Film::new(
             self.resolution.0 as usize,
             self.resolution.1 as usize,
             self.sensor,
-        )
+        );
+        if self.moments {
+            film.with_moments()
+        } else {
+            film
+        }
     }
 
     /// The pixel sampler of sample `index` of pixel `(x, y)`, with stream `seed`.

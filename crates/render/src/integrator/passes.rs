@@ -13,7 +13,7 @@ use super::{IntegratorState, RenderControl, RenderOutput, Stats};
 use crate::context::{Progress, RenderContext};
 use crate::geometry::Ray;
 use crate::sampler::PixelSample;
-use radiant_image::{Film, NonFinite};
+use radiant_image::{Film, FilmPixel, NonFinite};
 use radiant_math::color::Rgb;
 
 /// Which sample of which pixel is being estimated.
@@ -124,46 +124,80 @@ fn render_pass<E: PixelEstimator>(
     progress: &Progress,
 ) -> NonFinite {
     let width = film.width;
-    film.pixels
-        .par_chunks_mut(width)
-        .enumerate()
-        .map(|(y, row)| {
-            let mut nonfinite = NonFinite::default();
-            if progress.cancelled() {
-                return nonfinite;
-            }
-            let mut rays = 0u64;
-            let mut row_samples = 0u64;
-            let mut scratch = estimator.scratch();
-            for (x, film_pixel) in row.iter_mut().enumerate() {
-                for index in film_pixel.samples.max(first)..first + count {
-                    let pixel = PixelId {
-                        x: x as u32,
-                        y: y as u32,
-                        index,
-                    };
-                    row_samples += 1;
-                    let (l, weight, r) = sample_pixel(ctx, estimator, &mut scratch, pixel);
-                    rays += r as u64;
-                    if l.is_finite() && weight.is_finite() {
-                        film_pixel.add(l, weight);
-                    } else {
-                        film_pixel.samples += 1;
-                        nonfinite.merge(NonFinite {
-                            count: 1,
-                            first_pixel: Some((pixel.x, pixel.y)),
-                        });
+    let merge = |mut a: NonFinite, b: NonFinite| {
+        a.merge(b);
+        a
+    };
+    let Film {
+        pixels, moments, ..
+    } = film;
+    let row = |y: usize, row: &mut [FilmPixel], moments: Option<&mut [[f64; 3]]>| {
+        render_row(ctx, estimator, y, row, moments, first, count, progress)
+    };
+    match moments {
+        None => pixels
+            .par_chunks_mut(width)
+            .enumerate()
+            .map(|(y, r)| row(y, r, None))
+            .reduce(NonFinite::default, merge),
+        Some(m) => pixels
+            .par_chunks_mut(width)
+            .zip(m.par_chunks_mut(width))
+            .enumerate()
+            .map(|(y, (r, m))| row(y, r, Some(m)))
+            .reduce(NonFinite::default, merge),
+    }
+}
+
+/// Adds samples `first .. first + count` to the pixels of row `y` (and, when kept,
+/// their squares to `moments`).
+#[allow(clippy::too_many_arguments)]
+fn render_row<E: PixelEstimator>(
+    ctx: &RenderContext,
+    estimator: &E,
+    y: usize,
+    row: &mut [FilmPixel],
+    mut moments: Option<&mut [[f64; 3]]>,
+    first: u32,
+    count: u32,
+    progress: &Progress,
+) -> NonFinite {
+    let mut nonfinite = NonFinite::default();
+    if progress.cancelled() {
+        return nonfinite;
+    }
+    let mut rays = 0u64;
+    let mut row_samples = 0u64;
+    let mut scratch = estimator.scratch();
+    for (x, film_pixel) in row.iter_mut().enumerate() {
+        for index in film_pixel.samples.max(first)..first + count {
+            let pixel = PixelId {
+                x: x as u32,
+                y: y as u32,
+                index,
+            };
+            row_samples += 1;
+            let (l, weight, r) = sample_pixel(ctx, estimator, &mut scratch, pixel);
+            rays += r as u64;
+            if l.is_finite() && weight.is_finite() {
+                film_pixel.add(l, weight);
+                if let Some(m) = moments.as_deref_mut() {
+                    for (s, v) in m[x].iter_mut().zip(l.to_array()) {
+                        *s += (v as f64) * (v as f64) * weight as f64;
                     }
                 }
+            } else {
+                film_pixel.samples += 1;
+                nonfinite.merge(NonFinite {
+                    count: 1,
+                    first_pixel: Some((pixel.x, pixel.y)),
+                });
             }
-            progress.rays.fetch_add(rays, Ordering::Relaxed);
-            progress.done.fetch_add(row_samples, Ordering::Relaxed);
-            nonfinite
-        })
-        .reduce(NonFinite::default, |mut a, b| {
-            a.merge(b);
-            a
-        })
+        }
+    }
+    progress.rays.fetch_add(rays, Ordering::Relaxed);
+    progress.done.fetch_add(row_samples, Ordering::Relaxed);
+    nonfinite
 }
 
 /// One camera sample: radiance times the camera's weight, filter weight, rays traced.

@@ -171,6 +171,8 @@ fn render(
     let mut count = vec![0u32; n_pix];
     let world = &ctx.world;
     let mut film = ctx.new_film();
+    // Its pixels are progressive estimates, not means of samples: no sample variance.
+    film.moments = None;
     let mut done = first;
     let snapshot_state = |state: &[PixelState], done: u32| IntegratorState::Sppm {
         iterations: done,
