@@ -40,7 +40,12 @@ enum Command {
 /// is neither a subcommand nor a top-level flag (help, version), the arguments are
 /// `render`'s. A scene file named like a subcommand is reached as `./render`.
 fn with_default_subcommand(mut args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
-    let Some(first) = args.get(1).and_then(|a| a.to_str()) else {
+    let Some(first) = args.get(1) else {
+        return args;
+    };
+    // A name that is not UTF-8 is no subcommand: a scene path.
+    let Some(first) = first.to_str() else {
+        args.insert(1, "render".into());
         return args;
     };
     let cmd = Cli::command();
