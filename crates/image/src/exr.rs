@@ -405,6 +405,50 @@ mod tests {
     }
 
     #[test]
+    fn extra_channels_are_written_beside_rgb_and_read_back_by_name() {
+        let img = pattern(9, 5);
+        let n = 9 * 5;
+        let extra = vec![
+            (
+                "Z".to_string(),
+                (0..n).map(|i| i as f32 * 0.5).collect::<Vec<f32>>(),
+            ),
+            ("Albedo.R".to_string(), vec![0.25; n]),
+            ("N.X".to_string(), vec![-1.0; n]),
+        ];
+        let path = temp_path("channels.exr");
+        let meta = ImageMeta {
+            samples_per_pixel: Some(4),
+            ..ImageMeta::default()
+        };
+        write_exr_channels(&path, &img, &meta, &extra).unwrap();
+        // The colour is read as before: the shortest R, G, B names.
+        assert_eq!(read_exr(&path).unwrap(), img);
+        let file = x::read_all_flat_layers_from_file(&path).unwrap();
+        let list = &file.layer_data[0].channel_data.list;
+        let names: Vec<String> = list.iter().map(|c| c.name.to_string()).collect();
+        assert_eq!(names, ["Albedo.R", "B", "G", "N.X", "R", "Z"]);
+        let z: Vec<f32> = list[5].sample_data.values_as_f32().collect();
+        assert_eq!(z, extra[0].1);
+        // Same bytes every time; a wrong length or a repeated name is refused.
+        let again = temp_path("channels2.exr");
+        write_exr_channels(&again, &img, &meta, &extra).unwrap();
+        assert_eq!(
+            std::fs::read(&path).unwrap(),
+            std::fs::read(&again).unwrap()
+        );
+        let short = vec![("Z".to_string(), vec![0.0; n - 1])];
+        assert!(write_exr_channels(&again, &img, &meta, &short).is_err());
+        let twice = vec![
+            ("Z".to_string(), vec![0.0; n]),
+            ("Z".to_string(), vec![0.0; n]),
+        ];
+        assert!(write_exr_channels(&again, &img, &meta, &twice).is_err());
+        std::fs::remove_file(&path).ok();
+        std::fs::remove_file(&again).ok();
+    }
+
+    #[test]
     fn writing_is_deterministic_and_has_no_timestamp() {
         let img = pattern(64, 40);
         let meta = ImageMeta {
