@@ -3,6 +3,7 @@
 mod bench_cmd;
 mod compare_cmd;
 mod lens_cmd;
+mod pbrt_opts;
 mod radiosity_cmd;
 mod render_cmd;
 mod signals;
@@ -10,7 +11,7 @@ mod study_cmd;
 mod slurm_cmd;
 mod unit_cmd;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
 #[derive(Parser)]
 #[command(
@@ -47,8 +48,32 @@ enum Command {
     Slurm(slurm_cmd::SlurmArgs),
 }
 
+/// pbrt's habit `radiant scene.pbrt [more.pbrt …] [flags]`: when the first argument
+/// is neither a subcommand nor a top-level flag (help, version), the arguments are
+/// `render`'s. A scene file named like a subcommand is reached as `./render`.
+fn with_default_subcommand(mut args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
+    let Some(first) = args.get(1) else {
+        return args;
+    };
+    // A name that is not UTF-8 is no subcommand: a scene path.
+    let Some(first) = first.to_str() else {
+        args.insert(1, "render".into());
+        return args;
+    };
+    let cmd = Cli::command();
+    let is_subcommand = first == "help"
+        || cmd
+            .get_subcommands()
+            .any(|c| c.get_name() == first || c.get_all_aliases().any(|a| a == first));
+    let top_level_flag = matches!(first, "-h" | "--help" | "-V" | "--version");
+    if !is_subcommand && !top_level_flag {
+        args.insert(1, "render".into());
+    }
+    args
+}
+
 fn main() {
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(with_default_subcommand(std::env::args_os().collect()));
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(args),
         Command::Compare(args) => compare_cmd::run(args),

@@ -13,6 +13,7 @@ use radiant::image::{ImageMeta, write_image};
 use radiant::render::integrator::{CheckpointHook, IntegratorState};
 use radiant::render::{Overrides, Progress};
 
+use crate::pbrt_opts::{AOV_SAMPLES, LogLevel, MemoryUse, PassWatchers, PbrtArgs, PhaseTimes};
 use crate::signals::Interrupts;
 use radiant::scene::{
     SceneDesc,
@@ -24,6 +25,10 @@ use radiant::{INTEGRATOR_NAMES, Session};
 pub struct RenderArgs {
     /// A pbrt-v4 scene file, or a canonical scene: cornell-box (default), cornell-caustics, furnace.
     pub scene: Option<String>,
+    /// More pbrt-v4 scene files, read after the first as if appended to it (as
+    /// `pbrt a.pbrt b.pbrt` does).
+    #[arg(value_name = "MORE_SCENES")]
+    pub more_scenes: Vec<String>,
     /// Samples per pixel (overrides the scene's Sampler "pixelsamples").
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: Option<u32>,
@@ -60,6 +65,8 @@ pub struct RenderArgs {
     pub checkpoint: CheckpointArgs,
     #[command(flatten)]
     pub unit: crate::unit_cmd::UnitArgs,
+    #[command(flatten)]
+    pub pbrt: PbrtArgs,
 }
 
 /// Checkpoint and resume flags (shared by `render` and `radiosity`).
@@ -187,6 +194,19 @@ pub fn load_scene(scene: Option<&str>) -> anyhow::Result<SceneDesc> {
     Ok(radiant::scene::parse_file(path)?)
 }
 
+/// [`load_scene`], or with more files the files read in order as one scene.
+pub fn load_scenes(scene: Option<&str>, more: &[String]) -> anyhow::Result<SceneDesc> {
+    if more.is_empty() {
+        return load_scene(scene);
+    }
+    let paths: Vec<PathBuf> = scene
+        .into_iter()
+        .chain(more.iter().map(String::as_str))
+        .map(PathBuf::from)
+        .collect();
+    Ok(radiant::scene::parse_files(&paths)?)
+}
+
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     // A scene may name pbrt integrators radiant lacks (a warning, then the path tracer);
     // a name typed on the command line must be one radiant has.
@@ -207,9 +227,16 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if let Some(bytes) = args.memory_limit {
         radiant::render::budget::set_limit(bytes);
     }
-    let desc = load_scene(args.scene.as_deref())?;
-    for w in &desc.warnings {
-        eprintln!("{w}");
+    let mut times = PhaseTimes::default();
+    let phase = std::time::Instant::now();
+    let desc = load_scenes(args.scene.as_deref(), &args.more_scenes)?;
+    times.parse = phase.elapsed().as_secs_f64();
+    let warn = args.pbrt.log_level < LogLevel::Fatal;
+    let summary = !args.quiet && warn;
+    if warn {
+        for w in &desc.warnings {
+            eprintln!("{w}");
+        }
     }
     let output = args
         .output
@@ -218,24 +245,57 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if args.output.is_none() {
         check_output(&output)?;
     }
+    let mut aovs = args.pbrt.aov_set();
+    let variance = args.pbrt.wants_variance() || desc.film.gbuffer.is_some();
+    if desc.film.gbuffer.is_some() {
+        aovs = radiant::render::aov::AovSet::ALL;
+    }
+    if (aovs.any() || variance)
+        && radiant::image::Format::from_path(&output).ok() != Some(radiant::image::Format::Exr)
+    {
+        bail!(
+            "{}: AOV channels (--aov, Film \"gbuffer\") need an EXR output",
+            output.display()
+        );
+    }
     let overrides = Overrides {
-        spp: args.spp,
+        spp: if args.pbrt.quick { Some(1) } else { args.spp },
         seed: args.seed,
-        resolution: args.resolution,
+        resolution: if args.pbrt.quick {
+            Some(
+                args.pbrt.quick_resolution(
+                    args.resolution
+                        .unwrap_or((desc.film.xresolution, desc.film.yresolution)),
+                ),
+            )
+        } else {
+            args.resolution
+        },
         integrator: args.integrator.clone(),
     };
+    let phase = std::time::Instant::now();
     let mut session = Session::new(&desc, &overrides)?;
-    for w in &session.warnings {
-        eprintln!("{w}");
+    session.ctx.moments = variance;
+    times.build = phase.elapsed().as_secs_f64();
+    if warn {
+        for w in &session.warnings {
+            eprintln!("{w}");
+        }
     }
     // A unit of a distributed render restarts whole: its checkpoint would be its
     // partial file.
     if args.unit.any() && args.checkpoint.target().is_some() {
         bail!("--checkpoint and --resume render the whole image, not a unit of it");
     }
+    if args.unit.any() && (aovs.any() || variance) {
+        bail!("AOV channels (--aov, Film \"gbuffer\") are written for whole images, not for a unit of one");
+    }
     args.unit.load_solution(&mut session, &desc)?;
     let unit = args.unit.apply(&mut session)?;
     let image_wanted = args.unit.partial.is_none() || args.output.is_some();
+    let mut watchers =
+        PassWatchers::new(&args.pbrt, &output, args.exposure, session.ctx.film_size())?;
+    let counts_before = radiant::render::stats::Counts::now();
     let ckpt = &args.checkpoint;
     let key = ckpt.target().map(|_| session.run_key(&desc));
     let resume = match &key {
@@ -306,9 +366,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             std::ops::ControlFlow::Continue(())
         };
         let want_hook = key.is_some();
+        let want_watch = watchers.any();
+        let mut watch = |n: u32, film: &radiant::image::Film| watchers.pass(n, film);
         let out = pool.install(|| {
             let hook = want_hook.then_some(&mut hook as &mut CheckpointHook<'_>);
-            session.render_resumable(&progress, &mut snapshot, resume, hook)
+            let watch =
+                want_watch.then_some(&mut watch as &mut dyn FnMut(u32, &radiant::image::Film));
+            session.render_watched(&progress, &mut snapshot, resume, hook, watch)
         });
         bar_done.store(true, Ordering::SeqCst);
         for e in snapshot_errors.iter().chain(&checkpoint_errors) {
@@ -344,15 +408,85 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         args.unit
             .write_partial(&session, &desc, unit, &mut output_data)?;
     }
+    times.render = output_data.seconds;
+    let counts = radiant::render::stats::Counts::now().since(&counts_before);
+    let phase = std::time::Instant::now();
+    let channels = if aovs.any() {
+        let space = match desc.film.gbuffer {
+            Some(radiant::scene::GBufferSpace::World) => radiant::render::aov::AovSpace::World,
+            _ => radiant::render::aov::AovSpace::Camera(desc.camera.camera_from_world),
+        };
+        pool.install(|| {
+            radiant::render::aov::render_aovs(
+                &session.ctx,
+                aovs,
+                output_data.spp_done.clamp(1, AOV_SAMPLES),
+                space,
+                &desc.camera.camera_from_world,
+            )
+        })
+    } else {
+        Vec::new()
+    };
+    let mut channels = channels;
+    if variance {
+        match output_data.film.variance() {
+            Some(v) => {
+                for (name, values) in ["Variance.R", "Variance.G", "Variance.B"]
+                    .into_iter()
+                    .zip(v)
+                {
+                    channels.push(radiant::render::aov::Channel {
+                        name: name.into(),
+                        values,
+                    });
+                }
+            }
+            None if warn => eprintln!(
+                "warning: no variance channels: the {} integrator (or a resumed render) keeps no per-sample moments",
+                session.integrator.name()
+            ),
+            None => {}
+        }
+    }
+    times.aov = phase.elapsed().as_secs_f64();
     let meta = ImageMeta {
         samples_per_pixel: Some(output_data.spp_done),
         render_time_seconds: Some(output_data.seconds),
         software: format!("radiant {}", env!("CARGO_PKG_VERSION")),
     };
+    let image = output_data.film.image();
+    let phase = std::time::Instant::now();
     if image_wanted {
         let _writing = interrupts.writing();
-        write_image(&output, &output_data.film.image(), &meta, args.exposure)
-            .with_context(|| format!("writing {}", output.display()))?;
+        if channels.is_empty() {
+            write_image(&output, &image, &meta, args.exposure)
+        } else {
+            let extra: Vec<(String, Vec<f32>)> =
+                channels.into_iter().map(|c| (c.name, c.values)).collect();
+            radiant::image::exr::write_exr_channels(&output, &image, &meta, &extra)
+        }
+        .with_context(|| format!("writing {}", output.display()))?;
+    }
+    times.write = phase.elapsed().as_secs_f64();
+    watchers.finish(&image);
+    for e in &watchers.errors {
+        eprintln!("warning: {e}");
+    }
+    if args.pbrt.stats {
+        let memory = MemoryUse::of(
+            &session,
+            &output_data,
+            aovs_channel_count(aovs) + 3 * variance as usize,
+        );
+        let photons = output_data
+            .stats
+            .get::<radiant::render::integrator::PhotonMapStats>()
+            .map(|s| s.global_stored + s.caustic_stored);
+        print!(
+            "{}",
+            crate::pbrt_opts::format_stats(&counts, photons, &memory, &times)
+        );
     }
     let nf = output_data.film.nonfinite;
     if nf.count > 0 {
@@ -362,7 +496,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             nf.count
         );
     }
-    if !args.quiet {
+    if summary {
         let stats = output_data.stats.to_string();
         for line in stats.lines() {
             eprintln!("{line}");
@@ -386,6 +520,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// Channels the AOV set writes.
+fn aovs_channel_count(set: radiant::render::aov::AovSet) -> usize {
+    3 * (set.albedo as usize
+        + set.position as usize
+        + set.normal as usize
+        + set.shading_normal as usize)
+        + set.depth as usize
 }
 
 /// Checks that `path` names an image format and that its folder takes a new file.

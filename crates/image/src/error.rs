@@ -49,6 +49,10 @@ pub enum ImageError {
         limit: u64,
     },
 
+    /// Extra channels that cannot be written (wrong length, repeated or bad name).
+    #[error("{path}: {message}", path = path.display())]
+    Channels { path: PathBuf, message: String },
+
     /// The file name does not end in a known image extension.
     #[error("{path}: unknown image format (expected .exr, .pfm or .png)", path = path.display())]
     UnknownFormat { path: PathBuf },

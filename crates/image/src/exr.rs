@@ -103,6 +103,100 @@ pub fn write_exr(
     })
 }
 
+/// Writes `image` as [`write_exr`] does, with `extra` channels beside R, G and B: named
+/// as OpenEXR layers (`Albedo.R`, `N.X`) or bare (`Z`), each `width * height` float32
+/// values in row order. Channels are stored sorted by name, as the format requires.
+pub fn write_exr_channels(
+    path: impl AsRef<Path>,
+    image: &Image,
+    meta: &ImageMeta,
+    extra: &[(String, Vec<f32>)],
+) -> Result<(), ImageError> {
+    let path = path.as_ref();
+    if extra.is_empty() {
+        return write_exr(path, image, meta);
+    }
+    image.validate(path)?;
+    let n = image.width * image.height;
+    let mut names = std::collections::HashSet::new();
+    for (name, values) in extra {
+        if values.len() != n || matches!(name.as_str(), "R" | "G" | "B") || !names.insert(name) {
+            return Err(ImageError::Channels {
+                path: path.to_path_buf(),
+                message: format!(
+                    "channel {name}: {} values for a {}x{} image, or a repeated name",
+                    values.len(),
+                    image.width,
+                    image.height
+                ),
+            });
+        }
+    }
+    let software = if meta.software.is_empty() {
+        concat!("radiant ", env!("CARGO_PKG_VERSION")).to_string()
+    } else {
+        meta.software.clone()
+    };
+    let mut layer_attributes = x::LayerAttributes::default();
+    let latin1: String = software
+        .chars()
+        .map(|c| if (c as u32) < 256 { c } else { '?' })
+        .collect();
+    layer_attributes.software_name = Text::new_or_none(latin1);
+    if let Some(spp) = meta.samples_per_pixel {
+        let spp = i32::try_from(spp).unwrap_or(i32::MAX);
+        layer_attributes
+            .other
+            .insert(Text::from(ATTR_SAMPLES_PER_PIXEL), AttributeValue::I32(spp));
+    }
+    let encoding = x::Encoding {
+        compression: x::Compression::ZIP16,
+        blocks: x::Blocks::ScanLines,
+        line_order: x::LineOrder::Increasing,
+    };
+    let mut channels: Vec<x::AnyChannel<x::FlatSamples>> = Vec::with_capacity(3 + extra.len());
+    for (k, name) in ["R", "G", "B"].into_iter().enumerate() {
+        let values = image.pixels.iter().map(|p| p.to_array()[k]).collect();
+        channels.push(x::AnyChannel::new(name, x::FlatSamples::F32(values)));
+    }
+    for (name, values) in extra {
+        let text = Text::new_or_none(name.as_str()).ok_or_else(|| ImageError::Channels {
+            path: path.to_path_buf(),
+            message: format!("channel name {name:?} is not Latin-1 text"),
+        })?;
+        channels.push(x::AnyChannel::new(
+            text,
+            x::FlatSamples::F32(values.clone()),
+        ));
+    }
+    let layer = x::Layer::new(
+        (image.width, image.height),
+        layer_attributes,
+        encoding,
+        x::AnyChannels::sort(channels.into()),
+    );
+    let mut exr_image = x::Image::from_layer(layer);
+    exr_image.attributes.chromaticities = Some(rec709_chromaticities());
+    if let Some(t) = meta.render_time_seconds {
+        exr_image
+            .attributes
+            .other
+            .insert(Text::from(ATTR_RENDER_TIME), AttributeValue::F32(t as f32));
+    }
+    super::write_atomically(path, |file| {
+        exr_image
+            .write()
+            .to_buffered(file)
+            .map_err(|error| match error {
+                ::exr::error::Error::Io(e) => ImageError::io(path, e),
+                error => ImageError::Exr {
+                    path: path.to_path_buf(),
+                    error,
+                },
+            })
+    })
+}
+
 /// Reads the first layer of an EXR that has R, G and B channels (bare or as `<layer>.R`,
 /// preferring the shortest name, as `compare.py` does) or else a Y channel (grey).
 /// Samples may be f16, f32 or u32; they are converted to f32.
@@ -308,6 +402,50 @@ mod tests {
         );
         assert_eq!(attrs.compression.as_deref(), Some("ZIP16"));
         std::fs::remove_file(&path).ok();
+    }
+
+    #[test]
+    fn extra_channels_are_written_beside_rgb_and_read_back_by_name() {
+        let img = pattern(9, 5);
+        let n = 9 * 5;
+        let extra = vec![
+            (
+                "Z".to_string(),
+                (0..n).map(|i| i as f32 * 0.5).collect::<Vec<f32>>(),
+            ),
+            ("Albedo.R".to_string(), vec![0.25; n]),
+            ("N.X".to_string(), vec![-1.0; n]),
+        ];
+        let path = temp_path("channels.exr");
+        let meta = ImageMeta {
+            samples_per_pixel: Some(4),
+            ..ImageMeta::default()
+        };
+        write_exr_channels(&path, &img, &meta, &extra).unwrap();
+        // The colour is read as before: the shortest R, G, B names.
+        assert_eq!(read_exr(&path).unwrap(), img);
+        let file = x::read_all_flat_layers_from_file(&path).unwrap();
+        let list = &file.layer_data[0].channel_data.list;
+        let names: Vec<String> = list.iter().map(|c| c.name.to_string()).collect();
+        assert_eq!(names, ["Albedo.R", "B", "G", "N.X", "R", "Z"]);
+        let z: Vec<f32> = list[5].sample_data.values_as_f32().collect();
+        assert_eq!(z, extra[0].1);
+        // Same bytes every time; a wrong length or a repeated name is refused.
+        let again = temp_path("channels2.exr");
+        write_exr_channels(&again, &img, &meta, &extra).unwrap();
+        assert_eq!(
+            std::fs::read(&path).unwrap(),
+            std::fs::read(&again).unwrap()
+        );
+        let short = vec![("Z".to_string(), vec![0.0; n - 1])];
+        assert!(write_exr_channels(&again, &img, &meta, &short).is_err());
+        let twice = vec![
+            ("Z".to_string(), vec![0.0; n]),
+            ("Z".to_string(), vec![0.0; n]),
+        ];
+        assert!(write_exr_channels(&again, &img, &meta, &twice).is_err());
+        std::fs::remove_file(&path).ok();
+        std::fs::remove_file(&again).ok();
     }
 
     #[test]

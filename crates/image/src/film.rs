@@ -104,6 +104,9 @@ pub struct Film {
     pub pixels: Vec<FilmPixel>,
     pub nonfinite: NonFinite,
     pub sensor: Sensor,
+    /// Per-pixel filter-weighted sums of squared samples (w·L² per channel), kept when
+    /// a variance channel is asked for; not part of checkpoints.
+    pub moments: Option<Vec<[f64; 3]>>,
 }
 
 impl Film {
@@ -114,7 +117,34 @@ impl Film {
             pixels: vec![FilmPixel::default(); width * height],
             nonfinite: NonFinite::default(),
             sensor,
+            moments: None,
         }
+    }
+
+    /// The same film keeping second moments for [`Film::variance`].
+    pub fn with_moments(mut self) -> Film {
+        self.moments = Some(vec![[0.0; 3]; self.pixels.len()]);
+        self
+    }
+
+    /// Per pixel and channel, the filter-weighted variance of the samples as the sensor
+    /// records them (E_w[L²] − E_w[L]²), when the film keeps moments.
+    pub fn variance(&self) -> Option<[Vec<f32>; 3]> {
+        let moments = self.moments.as_ref()?;
+        let r2 = (self.sensor.imaging_ratio as f64).powi(2);
+        let mut out: [Vec<f32>; 3] = Default::default();
+        for (p, m) in self.pixels.iter().zip(moments) {
+            for c in 0..3 {
+                let v = if p.weight == 0.0 {
+                    0.0
+                } else {
+                    let mean = p.sum[c] / p.weight;
+                    ((m[c] / p.weight - mean * mean).max(0.0) * r2) as f32
+                };
+                out[c].push(v);
+            }
+        }
+        Some(out)
     }
 
     /// The current estimate: each pixel's weighted mean, as the sensor records it.

@@ -2,7 +2,7 @@
 //! integrator it names (or the command line names).
 
 use radiant_image::Film;
-use radiant_render::integrator::{CheckpointHook, IntegratorState};
+use radiant_render::integrator::{CheckpointHook, IntegratorState, PassWatch};
 use radiant_render::{Integrator, Overrides, Progress, RenderContext, RenderControl, RenderOutput};
 use radiant_scene::{SceneDesc, SceneError, Warning};
 
@@ -87,6 +87,19 @@ impl Session {
         resume: Option<IntegratorState>,
         checkpoint: Option<&'a mut CheckpointHook<'a>>,
     ) -> Result<RenderOutput, CheckpointError> {
+        self.render_watched(progress, snapshot, resume, checkpoint, None)
+    }
+
+    /// [`Session::render_resumable`], with `pass` seeing the film after every pass
+    /// (SPPM: iteration) and the samples per pixel done.
+    pub fn render_watched<'a>(
+        &self,
+        progress: &'a Progress,
+        snapshot: &'a mut dyn FnMut(u32, &Film),
+        resume: Option<IntegratorState>,
+        checkpoint: Option<&'a mut CheckpointHook<'a>>,
+        pass: Option<&'a mut PassWatch<'a>>,
+    ) -> Result<RenderOutput, CheckpointError> {
         if let Some(state) = &resume {
             let wanted = self.integrator.state_kind();
             if state.kind() != wanted {
@@ -108,6 +121,7 @@ impl Session {
         let mut control = RenderControl::new(progress, snapshot);
         control.resume = resume;
         control.checkpoint = checkpoint;
+        control.pass = pass;
         Ok(self.integrator.render(&self.ctx, &mut control))
     }
 }

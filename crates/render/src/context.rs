@@ -140,6 +140,8 @@ pub struct RenderContext {
     /// The pixels and samples to render (all of them unless set after `new`); the film
     /// covers `work.pixels` only.
     pub work: WorkUnit,
+    /// Films keep second moments for a variance channel (pass-loop integrators).
+    pub moments: bool,
 }
 
 /// One pixel sample's camera ray.
@@ -214,6 +216,7 @@ impl RenderContext {
             resolution,
             spp,
             work: WorkUnit::full(resolution, spp),
+            moments: false,
         };
         Ok((context, warnings))
     }
@@ -221,7 +224,12 @@ impl RenderContext {
     /// An empty film of the work unit's pixels, recording through the scene's sensor.
     pub fn new_film(&self) -> Film {
         let (w, h) = self.film_size();
-        Film::new(w as usize, h as usize, self.sensor)
+        let film = Film::new(w as usize, h as usize, self.sensor);
+        if self.moments {
+            film.with_moments()
+        } else {
+            film
+        }
     }
 
     /// The film's size: the work unit's pixel rectangle.
@@ -240,8 +248,12 @@ impl RenderContext {
         let fs = self.filter.sample(sampler.get_2d());
         let raster = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + fs.offset;
         let u_lens = sampler.get_2d();
+        let ray = self.camera.generate_ray(raster, u_lens);
+        if ray.is_some() {
+            crate::stats::add(crate::stats::Counter::CameraRays, 1);
+        }
         CameraSample {
-            ray: self.camera.generate_ray(raster, u_lens),
+            ray,
             filter_weight: fs.weight,
         }
     }

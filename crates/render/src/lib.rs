@@ -4,6 +4,7 @@
 #![forbid(unsafe_code)]
 
 pub mod accel;
+pub mod aov;
 pub mod bench;
 pub mod budget;
 pub mod camera;
@@ -13,6 +14,7 @@ pub mod integrator;
 pub mod light;
 pub mod material;
 pub mod sampler;
+pub mod stats;
 pub mod texture;
 pub mod world;
 

@@ -113,6 +113,7 @@ fn canonical_settings(
             filename: Some(format!("{scene}.exr")),
             diagonal_mm: 35.0,
             iso: 100.0,
+            gbuffer: None,
             loc: loc(scene),
         },
         SamplerDesc {

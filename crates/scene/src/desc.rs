@@ -84,7 +84,18 @@ pub struct FilmDesc {
     /// Sensor sensitivity; pbrt-v4 scales the image by `iso / 100` for the realistic
     /// camera's physical exposure. Default 100.
     pub iso: f32,
+    /// `Film "gbuffer"`: the image is written with its G-buffer channels.
+    pub gbuffer: Option<GBufferSpace>,
     pub loc: FileLoc,
+}
+
+/// The space of a G-buffer film's positions and normals (`"string coordinatesystem"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GBufferSpace {
+    /// The camera's space (pbrt-v4's default).
+    Camera,
+    /// Render (world) space.
+    World,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -22,5 +22,5 @@ pub mod token;
 pub use desc::*;
 pub use error::{FileLoc, SceneError, Warning};
 pub use params::{Param, ParamSet, ParamValue};
-pub use parser::{parse_file, parse_str};
+pub use parser::{parse_file, parse_files, parse_str};
 pub use texture::*;

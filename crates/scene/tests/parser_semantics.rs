@@ -491,7 +491,7 @@ fn area_lights_scale_and_power() {
 #[test]
 fn unsupported_things_warn_once_each_and_parse_on() {
     let s = parse(
-        "Sampler \"halton\"\nPixelFilter \"mitchell\" \"float B\" 0.3\nFilm \"gbuffer\"\nAccelerator \"bvh\"\n\
+        "Sampler \"halton\"\nPixelFilter \"mitchell\" \"float B\" 0.3\nFilm \"spectral\"\nAccelerator \"bvh\"\n\
          Option \"bool disablepixeljitter\" true\nWorldBegin\nTexture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" 4\n\
          MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\n\
          Shape \"curve\" \"point3 P\" [ 0 0 0 1 1 1 2 2 2 3 3 3 ]\nLightSource \"goniometric\"\n\

@@ -54,6 +54,9 @@ pub trait Integrator: Any + Send + Sync {
     }
 }
 
+/// Sees the film after a pass with the samples per pixel done ([`RenderControl::pass`]).
+pub type PassWatch<'a> = dyn FnMut(u32, &Film) + 'a;
+
 /// What a running render reports to, and is stopped by.
 pub struct RenderControl<'a> {
     pub progress: &'a Progress,
@@ -66,6 +69,9 @@ pub struct RenderControl<'a> {
     /// Sees every pass boundary; when set, the render also returns its final state
     /// ([`RenderOutput::state`]), finished or interrupted.
     pub checkpoint: Option<&'a mut CheckpointHook<'a>>,
+    /// Sees the film after every pass (SPPM: iteration) with the samples per pixel
+    /// done: live views, partial images, error curves.
+    pub pass: Option<&'a mut PassWatch<'a>>,
 }
 
 impl<'a> RenderControl<'a> {
@@ -75,6 +81,19 @@ impl<'a> RenderControl<'a> {
             snapshot,
             resume: None,
             checkpoint: None,
+            pass: None,
+        }
+    }
+
+    /// True when someone watches every pass (the film must then be made each time).
+    pub fn watches_passes(&self) -> bool {
+        self.pass.is_some()
+    }
+
+    /// Shows the film after a pass with `done` samples per pixel to the pass watcher.
+    pub fn after_pass(&mut self, done: u32, film: &Film) {
+        if let Some(watch) = self.pass.as_mut() {
+            watch(done, film);
         }
     }
 

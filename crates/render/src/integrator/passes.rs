@@ -93,6 +93,7 @@ pub fn render_passes<E: PixelEstimator>(
             break;
         }
         spp_done += n;
+        control.after_pass(spp_done, &film);
         if spp_done.is_power_of_two() {
             (control.snapshot)(spp_done, &film);
         }
@@ -181,58 +182,90 @@ fn render_pass<E: PixelEstimator>(
     progress: &Progress,
 ) -> NonFinite {
     let width = film.width;
+    let merge = |mut a: NonFinite, b: NonFinite| {
+        a.merge(b);
+        a
+    };
+    let Film {
+        pixels, moments, ..
+    } = film;
+    let row = |row_index: usize, row: &mut [FilmPixel], moments: Option<&mut [[f64; 3]]>| {
+        render_row(ctx, estimator, row_index, row, moments, first, count, progress)
+    };
+    match moments {
+        None => pixels
+            .par_chunks_mut(width)
+            .enumerate()
+            .map(|(y, r)| row(y, r, None))
+            .reduce(NonFinite::default, merge),
+        Some(m) => pixels
+            .par_chunks_mut(width)
+            .zip(m.par_chunks_mut(width))
+            .enumerate()
+            .map(|(y, (r, m))| row(y, r, Some(m)))
+            .reduce(NonFinite::default, merge),
+    }
+}
+
+/// Adds samples `first .. first + count` to the pixels of the film's row `row_index`
+/// (and, when kept, their squares to `moments`).
+#[allow(clippy::too_many_arguments)]
+fn render_row<E: PixelEstimator>(
+    ctx: &RenderContext,
+    estimator: &E,
+    row_index: usize,
+    row: &mut [FilmPixel],
+    mut moments: Option<&mut [[f64; 3]]>,
+    first: u32,
+    count: u32,
+    progress: &Progress,
+) -> NonFinite {
+    let mut nonfinite = NonFinite::default();
+    if progress.cancelled() {
+        return nonfinite;
+    }
     let (x0, y0) = (ctx.work.pixels.x0, ctx.work.pixels.y0);
-    film.pixels
-        .par_chunks_mut(width)
-        .enumerate()
-        .map(|(row_index, row)| {
-            let mut nonfinite = NonFinite::default();
-            if progress.cancelled() {
-                return nonfinite;
-            }
-            let y = y0 + row_index as u32;
-            let mut rays = 0u64;
-            let mut row_samples = 0u64;
-            let mut scratch = estimator.scratch();
-            for (column, film_pixel) in row.iter_mut().enumerate() {
-                let x = x0 + column as u32;
-                let mut open = FilmPixel::default();
-                let last = first + count;
-                for index in film_pixel.samples.max(first)..last {
-                    let pixel = PixelId { x, y, index };
-                    row_samples += 1;
-                    let (l, weight, r) = sample_pixel(ctx, estimator, &mut scratch, pixel);
-                    rays += r as u64;
-                    let target = if index < SAMPLE_BLOCK {
-                        &mut *film_pixel
-                    } else {
-                        &mut open
-                    };
-                    if l.is_finite() && weight.is_finite() {
-                        target.add(l, weight);
-                    } else {
-                        target.samples += 1;
-                        nonfinite.merge(NonFinite {
-                            count: 1,
-                            first_pixel: Some((pixel.x, pixel.y)),
-                        });
-                    }
-                    if index >= SAMPLE_BLOCK
-                        && ((index + 1) % SAMPLE_BLOCK == 0 || index + 1 == last)
-                    {
-                        fold(film_pixel, &open);
-                        open = FilmPixel::default();
+    let y = y0 + row_index as u32;
+    let mut rays = 0u64;
+    let mut row_samples = 0u64;
+    let mut scratch = estimator.scratch();
+    let last = first + count;
+    for (column, film_pixel) in row.iter_mut().enumerate() {
+        let x = x0 + column as u32;
+        let mut open = FilmPixel::default();
+        for index in film_pixel.samples.max(first)..last {
+            let pixel = PixelId { x, y, index };
+            row_samples += 1;
+            let (l, weight, r) = sample_pixel(ctx, estimator, &mut scratch, pixel);
+            rays += r as u64;
+            let target = if index < SAMPLE_BLOCK {
+                &mut *film_pixel
+            } else {
+                &mut open
+            };
+            if l.is_finite() && weight.is_finite() {
+                target.add(l, weight);
+                if let Some(m) = moments.as_deref_mut() {
+                    for (s, v) in m[column].iter_mut().zip(l.to_array()) {
+                        *s += (v as f64) * (v as f64) * weight as f64;
                     }
                 }
+            } else {
+                target.samples += 1;
+                nonfinite.merge(NonFinite {
+                    count: 1,
+                    first_pixel: Some((pixel.x, pixel.y)),
+                });
             }
-            progress.rays.fetch_add(rays, Ordering::Relaxed);
-            progress.done.fetch_add(row_samples, Ordering::Relaxed);
-            nonfinite
-        })
-        .reduce(NonFinite::default, |mut a, b| {
-            a.merge(b);
-            a
-        })
+            if index >= SAMPLE_BLOCK && ((index + 1) % SAMPLE_BLOCK == 0 || index + 1 == last) {
+                fold(film_pixel, &open);
+                open = FilmPixel::default();
+            }
+        }
+    }
+    progress.rays.fetch_add(rays, Ordering::Relaxed);
+    progress.done.fetch_add(row_samples, Ordering::Relaxed);
+    nonfinite
 }
 
 /// One camera sample: radiance times the camera's weight, filter weight, rays traced.

@@ -128,11 +128,13 @@ pub struct World {
 impl World {
     /// Closest hit in `(0, t_max)`.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
+        crate::stats::add(crate::stats::Counter::ClosestHitTests, 1);
         self.geometry.intersect(ray, t_max, &self.prototypes)
     }
 
     /// True when anything blocks the ray in `(0, t_max)`.
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        crate::stats::add(crate::stats::Counter::ShadowTests, 1);
         self.geometry.occluded(ray, t_max, &self.prototypes)
     }
 

@@ -46,6 +46,39 @@ pub fn parse_file(path: &Path) -> Result<SceneDesc, SceneError> {
     Ok(scene)
 }
 
+/// Parses several scene files as one: the files are read in order, each continuing the
+/// state the previous one left (as pbrt-v4 does with `pbrt a.pbrt b.pbrt`). Relative
+/// paths resolve from the writing file's folder, then from the first file's.
+pub fn parse_files(paths: &[PathBuf]) -> Result<SceneDesc, SceneError> {
+    let Some((first, rest)) = paths.split_first() else {
+        return Err(SceneError::file(Path::new("-"), "no scene file given"));
+    };
+    if rest.is_empty() {
+        return parse_file(first);
+    }
+    let read = |path: &PathBuf| {
+        read_text(path).map_err(|e| {
+            e.into_error(|m| SceneError::file(path, format!("cannot read scene: {m}")))
+        })
+    };
+    let text = read(first)?;
+    let base_dir = first.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut parser = Parser::new(text, &first.display().to_string(), &base_dir);
+    // The include stack reads its last entry first: the later files go beneath the
+    // first, in reverse, so that each starts where the one before it ends.
+    for path in rest.iter().rev() {
+        let source = Source {
+            lexer: Lexer::new(read(path)?, path.display().to_string()),
+            dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        };
+        parser.sources.insert(0, source);
+    }
+    parser.run()?;
+    let mut scene = parser.finish()?;
+    scene.source = Some(first.to_path_buf());
+    Ok(scene)
+}
+
 /// Parses scene text. `name` is used in locations; relative paths (includes, meshes,
 /// lens files) resolve from `base_dir`.
 pub fn parse_str(text: &str, name: &str, base_dir: &Path) -> Result<SceneDesc, SceneError> {
@@ -518,6 +551,7 @@ impl Parser {
                 filename: Some("pbrt.exr".into()),
                 diagonal_mm: 35.0,
                 iso: 100.0,
+                gbuffer: None,
                 loc: loc.clone(),
             }),
             sampler: self.sampler.unwrap_or_else(|| SamplerDesc {

@@ -105,9 +105,30 @@ impl Parser {
         let (name, _) = self.string_arg("Film")?;
         let ps = self.param_list()?;
         self.require_options("Film", loc)?;
+        let mut gbuffer = None;
         match name.as_str() {
             "rgb" => {}
-            "gbuffer" | "spectral" => {
+            "gbuffer" => {
+                gbuffer = Some(
+                    match ps.string("coordinatesystem", "camera".into())?.as_str() {
+                        "camera" => GBufferSpace::Camera,
+                        "world" => GBufferSpace::World,
+                        other => {
+                            let at = ps
+                                .lookup("coordinatesystem")
+                                .map_or(loc, |p| &p.loc)
+                                .clone();
+                            return Err(SceneError::at(
+                                &at,
+                                format!(
+                                    "coordinatesystem \"{other}\": expected \"camera\" or \"world\""
+                                ),
+                            ));
+                        }
+                    },
+                );
+            }
+            "spectral" => {
                 ps.lookup("coordinatesystem");
                 for p in ["nbuckets", "lambdamin", "lambdamax"] {
                     ps.lookup(p);
@@ -133,6 +154,7 @@ impl Parser {
             filename: Some(ps.string("filename", "pbrt.exr".into())?),
             diagonal_mm: ps.finite_float("diagonal", 35.0)?,
             iso: ps.finite_float("iso", 100.0)?,
+            gbuffer,
             loc: loc.clone(),
         };
         let sensor_is_default = matches!(ps.strings("sensor")?, Some(([s], _)) if s == "cie1931");

@@ -116,6 +116,7 @@ pub fn trace_photon(
     let mut specular_chain = true;
     let mut first_specular = false;
     let mut rays = 0u32;
+    crate::stats::add(crate::stats::Counter::PhotonPaths, 1);
     for bounces in 0..max_depth {
         rays += 1;
         let Some(hit) = world.intersect(&ray, f32::INFINITY) else {
@@ -171,6 +172,7 @@ pub fn trace_photon(
         }
         ray = hit.spawn_ray(wi_world);
     }
+    crate::stats::add(crate::stats::Counter::PhotonRays, rays as u64);
     rays
 }
 

@@ -176,6 +176,8 @@ fn render(
     let mut count = vec![0u32; n_pix];
     let world = &ctx.world;
     let mut film = ctx.new_film();
+    // Its pixels are progressive estimates, not means of samples: no sample variance.
+    film.moments = None;
     let mut done = first;
     let snapshot_state = |state: &[PixelState], done: u32| IntegratorState::Sppm {
         iterations: done,
@@ -287,8 +289,12 @@ fn render(
             .fetch_add(camera_rays + photon_rays, Ordering::Relaxed);
         progress.done.fetch_add(n_pix as u64, Ordering::Relaxed);
         done = it + 1;
-        if done.is_power_of_two() {
+        let snapshot = done.is_power_of_two();
+        if snapshot || control.watches_passes() {
             write_estimates(&mut film, &state, done, n_photons);
+            control.after_pass(done, &film);
+        }
+        if snapshot {
             (control.snapshot)(done, &film);
         }
         control.boundary(done, &|| snapshot_state(&state, done));
