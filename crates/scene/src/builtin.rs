@@ -370,6 +370,7 @@ fn assemble(
         filter,
         integrator,
         materials,
+        shading_normals: Vec::new(),
         textures: Vec::new(),
         shapes,
         objects: Vec::new(),

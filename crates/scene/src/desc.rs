@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 
 use super::error::{FileLoc, Warning};
 use super::params::ParamSet;
-use super::texture::{TextureDesc, TexturedMaterialDesc};
+use super::texture::{ShadingNormalDesc, TextureDesc, TexturedMaterialDesc};
 use radiant_math::Transform;
 use radiant_math::color::Rgb;
 
@@ -24,6 +24,9 @@ pub struct SceneDesc {
     pub filter: FilterDesc,
     pub integrator: IntegratorDesc,
     pub materials: Vec<MaterialDesc>,
+    /// Bump or normal map of material i, at index i; shorter than `materials` when the
+    /// last ones have none (read it with [`SceneDesc::shading_normal`]).
+    pub shading_normals: Vec<Option<ShadingNormalDesc>>,
     /// Named textures, referred to by index from textured materials and other textures.
     pub textures: Vec<TextureDesc>,
     pub shapes: Vec<ShapeDesc>,
@@ -35,6 +38,13 @@ pub struct SceneDesc {
     pub warnings: Vec<Warning>,
     /// The scene file, when the scene came from one (relative paths resolve from its folder).
     pub source: Option<PathBuf>,
+}
+
+impl SceneDesc {
+    /// The bump or normal map of material `id`, if it has one.
+    pub fn shading_normal(&self, id: MaterialId) -> Option<&ShadingNormalDesc> {
+        self.shading_normals.get(id as usize)?.as_ref()
+    }
 }
 
 /// `Camera`: where it is and how it forms the image.

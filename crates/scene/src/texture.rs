@@ -228,6 +228,18 @@ pub enum TexturedMaterialDesc {
     },
 }
 
+/// How a material tilts the shading normal before its BSDF is evaluated.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShadingNormalDesc {
+    /// `displacement`: a float texture read as a height along the shading normal; the
+    /// normal is that of the displaced surface, from finite differences in (u, v)
+    /// (Blinn 1978, "Simulation of wrinkled surfaces").
+    Bump { displacement: TextureId },
+    /// `normalmap`: an image (read as linear) whose RGB in [0, 1] encodes a unit normal
+    /// in the tangent frame (∂p/∂u, n × ∂p/∂u, n) as 2 RGB − 1, looked up at (u, 1 − v).
+    NormalMap { filename: PathBuf },
+}
+
 /// Microfacet roughness along the two tangent axes, possibly textured. With
 /// `remap` the values are pbrt's roughness and alpha = √roughness; otherwise they are
 /// alphas already.

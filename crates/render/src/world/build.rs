@@ -61,6 +61,7 @@ impl World {
             })
             .collect();
         let materials = material_table(&desc.materials, &textures)?;
+        let shading_normals = super::normals::build_shading_normals(desc)?;
         let mut lights = Vec::new();
 
         let mut prototypes = Vec::with_capacity(desc.objects.len());
@@ -109,6 +110,7 @@ impl World {
             materials,
             textured,
             textures,
+            shading_normals,
             ray_spread: RaySpread::NONE,
             lights,
             light_sampler,

@@ -5,11 +5,13 @@
 //! lazy expansion of a hit into a [`SurfaceHit`] with positions, normals and uvs.
 
 mod build;
+mod normals;
 mod shapes;
 
 use glam::{Vec2, Vec3};
 
 pub use build::BuildError;
+pub use normals::ShadingNormal;
 pub use shapes::ShapeSet;
 
 use crate::camera::RaySpread;
@@ -117,6 +119,9 @@ pub struct World {
     /// The textured description of each material id that has one.
     pub(crate) textured: Vec<Option<TexturedMaterialDesc>>,
     pub textures: TextureSet,
+    /// Bump or normal map by material id (empty when none has one); applied to every
+    /// hit [`World::intersect`] returns.
+    pub(crate) shading_normals: Vec<Option<ShadingNormal>>,
     /// The camera's pixel footprint along paths, for texture filtering.
     pub ray_spread: RaySpread,
     pub lights: Vec<Light>,
@@ -127,8 +132,22 @@ pub struct World {
 
 impl World {
     /// Closest hit in `(0, t_max)`.
+    /// The shading normal is that of the hit's material (bump or normal map applied).
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
-        self.geometry.intersect(ray, t_max, &self.prototypes)
+        let mut hit = self.geometry.intersect(ray, t_max, &self.prototypes)?;
+        if !self.shading_normals.is_empty() {
+            self.perturb_shading_normal(&mut hit, -ray.d.normalize());
+        }
+        Some(hit)
+    }
+
+    /// Tilts `hit.ns` by the bump or normal map of the material that shades it seen
+    /// from `wo_world` (for a mix, the chosen material's).
+    fn perturb_shading_normal(&self, hit: &mut SurfaceHit, wo_world: Vec3) {
+        let index = self.resolve_index(hit.material, hit.p, wo_world);
+        if let Some(Some(normal)) = self.shading_normals.get(index as usize) {
+            normals::perturb(hit, normal, &self.textures);
+        }
     }
 
     /// True when anything blocks the ray in `(0, t_max)`.

@@ -42,7 +42,9 @@ use crate::error::{FileLoc, SceneError};
 use crate::named_spectra::{glass_eta, metal_spectrum};
 use crate::params::{ParamSet, ParamValue};
 use crate::spectrum::{interpolate, pairs_from_flat};
-use crate::texture::{FloatParam, RoughnessDesc, TexturedMaterialDesc, TexturedParam};
+use crate::texture::{
+    FloatParam, RoughnessDesc, ShadingNormalDesc, TexturedMaterialDesc, TexturedParam,
+};
 use radiant_math::color::Rgb;
 
 /// pbrt-v4's material types that radiant replaces by diffuse 0.5.
@@ -58,9 +60,12 @@ impl Parser {
         let ps = with_defaults(self.param_list()?, &self.gs.defaults.material);
         self.require_world("Material", loc)?;
         let owner = format!("Material \"{ty}\"");
+        let normal = self.shading_normal_param(&ps)?;
         let m = self.build_material(&ty, &ps, loc, &owner)?;
         self.report_unused(&ps, &owner);
-        self.gs.material = Some(self.push_material(m));
+        let id = self.push_material(m);
+        self.set_shading_normal(id, normal);
+        self.gs.material = Some(id);
         Ok(())
     }
 
@@ -86,9 +91,11 @@ impl Parser {
                 format!("named material \"{name}\" is defined twice"),
             ));
         }
+        let normal = self.shading_normal_param(&ps)?;
         let m = self.build_material(&ty, &ps, loc, &owner)?;
         self.report_unused(&ps, &owner);
         let id = self.push_material(m);
+        self.set_shading_normal(id, normal);
         self.named_materials.insert(name, id);
         Ok(())
     }
@@ -111,6 +118,48 @@ impl Parser {
                 format!("unknown named material \"{name}\""),
             )),
         }
+    }
+
+    /// `normalmap` (an image file) or `displacement` (a float texture; a constant
+    /// displacement moves the surface without tilting it, so it is dropped). A normal
+    /// map wins over a displacement, as in pbrt-v4.
+    fn shading_normal_param(
+        &mut self,
+        ps: &ParamSet,
+    ) -> Result<Option<ShadingNormalDesc>, SceneError> {
+        let displacement = self.float_texture_param(ps, "displacement", 0.0)?;
+        if let Some((names, at)) = ps.strings("normalmap")? {
+            let [written] = names else {
+                return Err(SceneError::at(at, "\"string normalmap\" needs one value"));
+            };
+            if written.is_empty() {
+                return Ok(None);
+            }
+            let at = at.clone();
+            let filename = self.resolve_path(written);
+            if !filename.is_file() {
+                return Err(SceneError::at(
+                    &at,
+                    format!("normal map '{}' not found", filename.display()),
+                ));
+            }
+            return Ok(Some(ShadingNormalDesc::NormalMap { filename }));
+        }
+        Ok(match displacement {
+            TexturedParam::Texture(displacement) => Some(ShadingNormalDesc::Bump { displacement }),
+            TexturedParam::Constant(_) => None,
+        })
+    }
+
+    fn set_shading_normal(&mut self, id: MaterialId, normal: Option<ShadingNormalDesc>) {
+        if normal.is_none() {
+            return;
+        }
+        let i = id as usize;
+        if self.shading_normals.len() <= i {
+            self.shading_normals.resize(i + 1, None);
+        }
+        self.shading_normals[i] = normal;
     }
 
     fn push_material(&mut self, m: MaterialDesc) -> MaterialId {
@@ -142,15 +191,6 @@ impl Parser {
         loc: &FileLoc,
         owner: &str,
     ) -> Result<MaterialDesc, SceneError> {
-        for unsupported in ["displacement", "normalmap"] {
-            if let Some(p) = ps.lookup(unsupported) {
-                let at = p.loc.clone();
-                self.warn(
-                    &at,
-                    format!("{owner}: \"{unsupported}\" is not supported; ignored"),
-                );
-            }
-        }
         Ok(match ty {
             "diffuse" => match self.spectrum_texture_param(
                 ps,
