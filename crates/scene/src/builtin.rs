@@ -73,6 +73,7 @@ fn sphere(center: Vec3, radius: f32, material: MaterialId, scene: &str) -> Shape
         reverse_orientation: false,
         material,
         area_light: None,
+        alpha: None,
         loc: loc(scene),
     }
 }

@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 
 use super::error::{FileLoc, Warning};
 use super::params::ParamSet;
-use super::texture::{ShadingNormalDesc, TextureDesc, TexturedMaterialDesc};
+use super::texture::{FloatParam, ShadingNormalDesc, TextureDesc, TexturedMaterialDesc};
 use radiant_math::Transform;
 use radiant_math::color::Rgb;
 
@@ -289,6 +289,10 @@ pub struct ShapeDesc {
     pub reverse_orientation: bool,
     pub material: MaterialId,
     pub area_light: Option<AreaLightDesc>,
+    /// pbrt-v4's `alpha` cut-out: where it is 0 rays pass through the shape as if it
+    /// were not there, where fractional they pass with probability 1 − alpha. `None`
+    /// for an opaque shape (alpha 1).
+    pub alpha: Option<FloatParam>,
     pub loc: FileLoc,
 }
 
@@ -314,6 +318,7 @@ impl ShapeDesc {
             reverse_orientation: false,
             material,
             area_light: None,
+            alpha: None,
             loc,
         }
     }

@@ -111,6 +111,11 @@ impl World {
             textured,
             textures,
             shading_normals,
+            cut_outs: desc
+                .shapes
+                .iter()
+                .chain(desc.objects.iter().flat_map(|o| o.shapes.iter()))
+                .any(|s| s.alpha.is_some()),
             ray_spread: RaySpread::NONE,
             lights,
             light_sampler,
@@ -458,6 +463,7 @@ fn add_shape(
                     material,
                     light,
                     orientation,
+                    alpha: shape.alpha,
                 });
                 set.prims.push(PrimRef::Bilinear(i));
             }
@@ -502,6 +508,7 @@ fn add_shape(
                 material,
                 light,
                 reverse: ro,
+                alpha: shape.alpha,
             });
             set.prims.push(PrimRef::Sphere(i));
         }
@@ -536,6 +543,7 @@ fn add_shape(
                 material,
                 light,
                 reverse: ro,
+                alpha: shape.alpha,
             });
             set.prims.push(PrimRef::Disk(i));
         }
@@ -633,5 +641,6 @@ fn add_mesh(
         normals: n,
         uvs: uvs.clone(),
         bilinear_halves: false,
+        alpha: shape.alpha,
     });
 }
