@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use glam::Vec3;
 
-use crate::desc::ConductorDesc;
+use crate::desc::{CoatDesc, ConductorDesc};
 use crate::error::FileLoc;
 use radiant_math::Transform;
 use radiant_math::color::Rgb;
@@ -225,6 +225,11 @@ pub enum TexturedMaterialDesc {
     RoughConductor {
         conductor: ConductorDesc,
         roughness: RoughnessDesc,
+    },
+    /// `coateddiffuse` with a textured base `reflectance` (clamped to [0, 1]).
+    CoatedDiffuse {
+        reflectance: SpectrumParam,
+        coat: CoatDesc,
     },
 }
 

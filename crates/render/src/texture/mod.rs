@@ -310,6 +310,10 @@ pub fn concrete_material(
                 alpha_v,
             }
         }
+        TexturedMaterialDesc::CoatedDiffuse { reflectance, coat } => MaterialDesc::CoatedDiffuse {
+            reflectance: spectrum(*reflectance),
+            coat: *coat,
+        },
     };
     Material::from_desc(&plain)
 }

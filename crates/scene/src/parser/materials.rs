@@ -19,7 +19,7 @@
 //!   alphas below its smooth threshold a delta BSDF). Roughness may be a float
 //!   texture.
 //! - `"coateddiffuse"`: a dielectric coat over a Lambertian base: `reflectance`
-//!   (0.5), the coat's `roughness` / `uroughness` / `vroughness` (0) and
+//!   (0.5, or a spectrum texture), the coat's `roughness` / `uroughness` / `vroughness` (0) and
 //!   `remaproughness` as above, `eta` (1.5, as for `dielectric`), and the slab between:
 //!   `thickness` (0.01), medium `albedo` (0) and Henyey–Greenstein `g` (0), random
 //!   walk `maxdepth` (10) and `nsamples` (1).
@@ -30,6 +30,9 @@
 //!   default copper, or `reflectance`; `conductor.roughness`, ...).
 //! - Textured floats of the layered materials (`thickness`, `g`, roughness) are
 //!   reported and read as their defaults.
+//! - Any material takes `displacement` (a float texture: bump mapping) or
+//!   `normalmap` (an image file, relative to the scene file); see
+//!   [`crate::ShadingNormalDesc`].
 //! - A material with a texture-valued parameter becomes [`MaterialDesc::Textured`];
 //!   one whose parameters are all constant keeps its plain variant.
 //! - Other material types render as diffuse 0.5 with a warning.
@@ -239,16 +242,24 @@ impl Parser {
                     }
                 }
             }
-            "coateddiffuse" => MaterialDesc::CoatedDiffuse {
-                reflectance: self.spectrum_or(
+            "coateddiffuse" => {
+                let reflectance = self.spectrum_texture_param(
                     ps,
                     "reflectance",
                     SpectrumUse::Albedo,
                     Rgb::splat(0.5),
-                    owner,
-                )?,
-                coat: self.coat_desc(ps, "", loc, owner)?,
-            },
+                )?;
+                let coat = self.coat_desc(ps, "", loc, owner)?;
+                match reflectance {
+                    TexturedParam::Constant(reflectance) => {
+                        MaterialDesc::CoatedDiffuse { reflectance, coat }
+                    }
+                    reflectance => MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse {
+                        reflectance,
+                        coat,
+                    }),
+                }
+            }
             "coatedconductor" => {
                 let coat = self.coat_desc(ps, "interface.", loc, owner)?;
                 let (alpha_u, alpha_v) = self.constant_alpha(ps, "conductor.", owner)?;
