@@ -114,6 +114,8 @@ fn canonical_settings(
             filename: Some(format!("{scene}.exr")),
             diagonal_mm: 35.0,
             iso: 100.0,
+            max_component_value: f32::INFINITY,
+            white_balance: None,
             loc: loc(scene),
         },
         SamplerDesc {

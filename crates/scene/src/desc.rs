@@ -94,6 +94,12 @@ pub struct FilmDesc {
     /// Sensor sensitivity; pbrt-v4 scales the image by `iso / 100` for the realistic
     /// camera's physical exposure. Default 100.
     pub iso: f32,
+    /// `maxcomponentvalue`: a sample whose largest CIE XYZ component (as the sensor
+    /// records it) is above this is scaled down to it. Infinite by default.
+    pub max_component_value: f32,
+    /// `whitebalance`: the colour temperature (K) of the CIE daylight illuminant that
+    /// is mapped to the output's white (D65); `None`: no white balance.
+    pub white_balance: Option<f32>,
     pub loc: FileLoc,
 }
 

@@ -145,7 +145,7 @@ fn render_pass<E: PixelEstimator>(
                     let (l, weight, r) = sample_pixel(ctx, estimator, &mut scratch, pixel);
                     rays += r as u64;
                     if l.is_finite() && weight.is_finite() {
-                        film_pixel.add(l, weight);
+                        film_pixel.add(ctx.sensor.clamp_sample(l), weight);
                     } else {
                         film_pixel.samples += 1;
                         nonfinite.merge(NonFinite {

@@ -521,6 +521,8 @@ impl Parser {
                 filename: Some("pbrt.exr".into()),
                 diagonal_mm: 35.0,
                 iso: 100.0,
+                max_component_value: f32::INFINITY,
+                white_balance: None,
                 loc: loc.clone(),
             }),
             sampler: self.sampler.unwrap_or_else(|| SamplerDesc {
