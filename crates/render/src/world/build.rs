@@ -86,7 +86,8 @@ impl World {
             )?;
         }
         for inst in &desc.instances {
-            if prototypes[inst.object].is_empty() {
+            // A singular instance transform has collapsed the object.
+            if prototypes[inst.object].is_empty() || !inst.render_from_instance.is_invertible() {
                 continue;
             }
             let i = top.instances.len() as u32;
@@ -479,6 +480,9 @@ fn add_shape(
                 mesh.bilinear_halves = true;
             }
         }
+        // Quadrics are intersected in object space: under a singular transform (which
+        // the parser accepted with a warning) they have collapsed and are left out.
+        Geometry::Sphere { .. } | Geometry::Disk { .. } if !xf.is_invertible() => {}
         Geometry::Sphere {
             radius,
             z_min,

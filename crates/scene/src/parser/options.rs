@@ -30,6 +30,12 @@ impl Parser {
         let ps = self.param_list()?;
         self.require_options("Camera", loc)?;
         let camera_from_world = self.gs.ctm;
+        if !camera_from_world.is_invertible() {
+            return Err(SceneError::at(
+                loc,
+                "Camera: the current transform is singular (the camera needs its inverse)",
+            ));
+        }
         self.named_coord_systems
             .insert("camera".into(), camera_from_world.inverse());
         let kind = match name.as_str() {
