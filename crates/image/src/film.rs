@@ -123,10 +123,7 @@ impl Sensor {
         if self.max_component == f32::INFINITY {
             return l;
         }
-        let xyz = crate::white_balance::apply(
-            &crate::white_balance::XYZ_FROM_RGB,
-            [l.r, l.g, l.b],
-        );
+        let xyz = crate::white_balance::apply(&crate::white_balance::XYZ_FROM_RGB, [l.r, l.g, l.b]);
         let m = xyz[0].max(xyz[1]).max(xyz[2]) * self.imaging_ratio;
         if m > self.max_component {
             l * (self.max_component / m)

@@ -39,10 +39,7 @@ impl Transform {
     /// pbrt-v4 does), so that whatever maps through the inverse finds nothing, while
     /// geometry mapped forwards collapses. [`Transform::is_invertible`] tells them apart.
     pub fn from_matrix_or_singular(m: Mat4) -> Transform {
-        Transform::from_matrix(m).unwrap_or(Transform {
-            m,
-            inv: Mat4::NAN,
-        })
+        Transform::from_matrix(m).unwrap_or(Transform { m, inv: Mat4::NAN })
     }
 
     /// False for a singular transform (or one composed with a singular one).

@@ -75,7 +75,8 @@ fn a_quad_of_alpha_zero_is_invisible_and_casts_no_shadow() {
         16,
     );
     let opaque = render(&write("opaque.pbrt", BLOCKER), 16);
-    let mean = |img: &Image| img.pixels.iter().map(|p| p.r as f64).sum::<f64>() / img.pixels.len() as f64;
+    let mean =
+        |img: &Image| img.pixels.iter().map(|p| p.r as f64).sum::<f64>() / img.pixels.len() as f64;
     // Rays that pass the cut-out restart just past it, so sample values may differ
     // in the last bits; anything more is the quad showing.
     let mut worst = 0.0f32;

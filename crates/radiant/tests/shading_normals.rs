@@ -98,10 +98,7 @@ fn a_normal_map_tilts_the_normal_in_the_tangent_frame() {
     // ∂p/∂u = +x.
     write_constant_map(&dir.join("tilt.pfm"), [0.75, 0.5, 1.0]);
     let desc = parse_in(
-        &square(
-            r#"Material "diffuse" "string normalmap" "tilt.pfm""#,
-            false,
-        ),
+        &square(r#"Material "diffuse" "string normalmap" "tilt.pfm""#, false),
         &dir,
     );
     let (ns, _) = hit_normal(&desc, 0.3, -0.4);
@@ -156,7 +153,11 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
     };
     let plain = dir.join("plain.pbrt");
     let mapped = dir.join("mapped.pbrt");
-    std::fs::write(&plain, body(r#"Material "coateddiffuse" "float roughness" 0.2"#)).unwrap();
+    std::fs::write(
+        &plain,
+        body(r#"Material "coateddiffuse" "float roughness" 0.2"#),
+    )
+    .unwrap();
     std::fs::write(
         &mapped,
         body(r#"Material "coateddiffuse" "float roughness" 0.2 "string normalmap" "flat.pfm""#),
@@ -170,7 +171,10 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
             .flat_map(|p| [p.r.to_bits(), p.g.to_bits(), p.b.to_bits()])
             .collect::<Vec<u32>>()
     };
-    assert!(bits(&a) == bits(&b), "a (0.5, 0.5, 1) normal map changed the image");
+    assert!(
+        bits(&a) == bits(&b),
+        "a (0.5, 0.5, 1) normal map changed the image"
+    );
 }
 
 #[test]

@@ -371,15 +371,19 @@ AttributeEnd
     let (world, _) = World::build(&desc).unwrap_or_else(|e| panic!("{e}"));
     // The triangle, flattened onto z = 0, is hit there; the collapsed sphere nowhere.
     let down = Ray::new(Vec3::new(0.0, -0.2, 10.0), Vec3::new(0.0, 0.0, -1.0));
-    let hit = world.intersect(&down, f32::INFINITY).expect("the flattened triangle");
+    let hit = world
+        .intersect(&down, f32::INFINITY)
+        .expect("the flattened triangle");
     assert!(hit.p.z.abs() < 1e-5, "{:?}", hit.p);
     let beside = Ray::new(Vec3::new(3.0, 0.0, 10.0), Vec3::new(0.0, 0.0, -1.0));
     assert!(world.intersect(&beside, f32::INFINITY).is_none());
 
     let camera = "Scale 1 0 1\nCamera \"perspective\"\nWorldBegin\n";
     let e = radiant_scene::parse_str(camera, "t.pbrt", dir)
-        .err()
-        .expect("the camera needs the inverse")
+        .expect_err("the camera needs the inverse")
         .to_string();
-    assert!(e.starts_with("t.pbrt:2:1:") && e.contains("singular"), "{e}");
+    assert!(
+        e.starts_with("t.pbrt:2:1:") && e.contains("singular"),
+        "{e}"
+    );
 }

@@ -458,7 +458,13 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
     // uv spans [0, 2]²: (0.25, 0.25) is in check (0, 0) (tex1), (0.75, 0.25) in (1, 0).
     let light = parse_in(&scene(r#""rgb reflectance" [0.9 0.9 0.9]"#), &dir);
     let dark = parse_in(&scene(r#""rgb reflectance" [0.1 0.1 0.1]"#), &dir);
-    assert_eq!(albedo_at(&textured, 0.25, 0.25), albedo_at(&light, 0.25, 0.25));
-    assert_eq!(albedo_at(&textured, 0.75, 0.25), albedo_at(&dark, 0.75, 0.25));
+    assert_eq!(
+        albedo_at(&textured, 0.25, 0.25),
+        albedo_at(&light, 0.25, 0.25)
+    );
+    assert_eq!(
+        albedo_at(&textured, 0.75, 0.25),
+        albedo_at(&dark, 0.75, 0.25)
+    );
     assert!(albedo_at(&light, 0.5, 0.5).r > 2.0 * albedo_at(&dark, 0.5, 0.5).r);
 }

@@ -622,8 +622,15 @@ fn film_sensor_white_balance_and_max_component_value() {
     assert_eq!(d.warnings.len(), 1, "{:?}", d.warnings);
     assert!(d.warnings[0].message.contains("CIE 1931"));
     let d = parse("Film \"rgb\" \"string sensor\" \"my_camera\"\nWorldBegin\n");
-    assert!(d.warnings[0].message.contains("unknown sensor \"my_camera\""));
+    assert!(
+        d.warnings[0]
+            .message
+            .contains("unknown sensor \"my_camera\"")
+    );
 
-    assert!(err("Film \"rgb\" \"float maxcomponentvalue\" 0\nWorldBegin\n").contains("maxcomponentvalue"));
+    assert!(
+        err("Film \"rgb\" \"float maxcomponentvalue\" 0\nWorldBegin\n")
+            .contains("maxcomponentvalue")
+    );
     assert!(err("Film \"rgb\" \"float whitebalance\" -1\nWorldBegin\n").contains("whitebalance"));
 }

@@ -67,7 +67,10 @@ fn diffuse_albedos(materials: &[MaterialDesc], textures: &TextureSet) -> Vec<[f6
             Some(MaterialDesc::Textured(TexturedMaterialDesc::Diffuse { reflectance })) => {
                 clamp(textures.uv_average(*reflectance, TEXTURE_AVERAGE_GRID))
             }
-            Some(MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse { reflectance, coat })) => {
+            Some(MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse {
+                reflectance,
+                coat,
+            })) => {
                 let d = MaterialDesc::CoatedDiffuse {
                     reflectance: textures.uv_average(*reflectance, TEXTURE_AVERAGE_GRID),
                     coat: *coat,

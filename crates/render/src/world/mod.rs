@@ -188,13 +188,14 @@ impl World {
             }
             let o = hit.spawn_origin(ray.d);
             t_base += (o - r.o).dot(ray.d) / ray.d.length_squared();
-            if !(t_base < t_max) {
+            if t_base >= t_max || t_base.is_nan() {
                 return None;
             }
             r = Ray::new(o, ray.d);
         }
         // So many layers of fractional alpha pass (almost) nothing: opaque.
-        self.geometry.intersect(&r, t_max - t_base, &self.prototypes)
+        self.geometry
+            .intersect(&r, t_max - t_base, &self.prototypes)
     }
 
     /// Whether the alpha of `hit` lets a ray of direction `d` through: always where
@@ -211,7 +212,7 @@ impl World {
         if a >= 1.0 {
             return false;
         }
-        if !(a > 0.0) {
+        if a <= 0.0 || a.is_nan() {
             return true;
         }
         let d = d.normalize();

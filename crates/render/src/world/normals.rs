@@ -41,7 +41,9 @@ const DEFAULT_STEP: f32 = 0.0005;
 #[derive(Clone, Debug)]
 pub enum ShadingNormal {
     /// Height from this float texture.
-    Bump { displacement: u32 },
+    Bump {
+        displacement: u32,
+    },
     NormalMap(Arc<Level>),
 }
 
@@ -62,11 +64,10 @@ pub(crate) fn build_shading_normals(
                 let level = match images.get(filename) {
                     Some(l) => l.clone(),
                     None => {
-                        let l = Arc::new(
-                            read_linear(filename, Some(ColorEncoding::Linear)).map_err(|e| {
-                                SceneError::file(filename, format!("normal map: {e}"))
-                            })?,
-                        );
+                        let l =
+                            Arc::new(read_linear(filename, Some(ColorEncoding::Linear)).map_err(
+                                |e| SceneError::file(filename, format!("normal map: {e}")),
+                            )?);
                         images.insert(filename.clone(), l.clone());
                         l
                     }

@@ -201,7 +201,10 @@ impl Parser {
         let t = ps.finite_float("whitebalance", 0.0)?;
         if t < 0.0 {
             let at = ps.lookup("whitebalance").expect("present").loc.clone();
-            return Err(SceneError::at(&at, "\"whitebalance\" must be positive (K) or 0 for none"));
+            return Err(SceneError::at(
+                &at,
+                "\"whitebalance\" must be positive (K) or 0 for none",
+            ));
         }
         Ok(if t > 0.0 {
             Some(t)
@@ -413,6 +416,9 @@ fn film_max_component(ps: &ParamSet) -> Result<f32, SceneError> {
     if v > 0.0 && !v.is_nan() {
         Ok(v)
     } else {
-        Err(SceneError::at(&at, "\"maxcomponentvalue\" must be positive"))
+        Err(SceneError::at(
+            &at,
+            "\"maxcomponentvalue\" must be positive",
+        ))
     }
 }

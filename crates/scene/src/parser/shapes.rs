@@ -28,8 +28,8 @@ use crate::mesh::{
     MeshData, first_non_finite2, first_non_finite3, first_out_of_range, repair_normals,
 };
 use crate::params::{ParamSet, ParamValue};
-use crate::{obj, ply, subdiv};
 use crate::texture::{FloatParam, TexturedParam};
+use crate::{obj, ply, subdiv};
 
 /// pbrt-v4 shapes radiant does not render.
 const SKIPPED_SHAPES: [&str; 6] = [

@@ -51,7 +51,9 @@ impl Parser {
         if !self.gs.ctm.is_invertible() && maps_through_the_transform(&kind) {
             return Err(SceneError::at(
                 loc,
-                format!("{owner}: the current transform is singular, and this mapping needs its inverse"),
+                format!(
+                    "{owner}: the current transform is singular, and this mapping needs its inverse"
+                ),
             ));
         }
         self.report_unused(&ps, &owner);
