@@ -226,6 +226,13 @@ pub enum TexturedMaterialDesc {
         conductor: ConductorDesc,
         roughness: RoughnessDesc,
     },
+    /// `diffusetransmission` with a textured `reflectance` or `transmittance`, each
+    /// multiplied by `scale` (then clamped to [0, 1]).
+    DiffuseTransmission {
+        reflectance: SpectrumParam,
+        transmittance: SpectrumParam,
+        scale: f32,
+    },
     /// `coateddiffuse` with a textured base `reflectance` (clamped to [0, 1]).
     CoatedDiffuse {
         reflectance: SpectrumParam,

@@ -67,6 +67,11 @@ fn diffuse_albedos(materials: &[MaterialDesc], textures: &TextureSet) -> Vec<[f6
             Some(MaterialDesc::Textured(TexturedMaterialDesc::Diffuse { reflectance })) => {
                 clamp(textures.uv_average(*reflectance, TEXTURE_AVERAGE_GRID))
             }
+            Some(MaterialDesc::Textured(TexturedMaterialDesc::DiffuseTransmission {
+                reflectance,
+                scale,
+                ..
+            })) => clamp(textures.uv_average(*reflectance, TEXTURE_AVERAGE_GRID) * *scale),
             Some(MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse {
                 reflectance,
                 coat,
@@ -114,6 +119,9 @@ fn material_type(m: &MaterialDesc) -> &'static str {
         MaterialDesc::Textured(TexturedMaterialDesc::RoughDielectric { .. }) => "dielectric",
         MaterialDesc::Textured(TexturedMaterialDesc::RoughConductor { .. }) => "conductor",
         MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse { .. }) => "coateddiffuse",
+        MaterialDesc::Textured(TexturedMaterialDesc::DiffuseTransmission { .. }) => {
+            "diffusetransmission"
+        }
         MaterialDesc::Interface => "interface",
     }
 }

@@ -6,8 +6,8 @@
 //! - `"conductor"`: `reflectance` (an artist's mirror colour), else `eta` and `k`
 //!   (spectra; default copper, `metal-Cu-eta` / `metal-Cu-k`).
 //! - `"thindielectric"`: `eta` as for `dielectric` (default 1.5).
-//! - `"diffusetransmission"`: `reflectance` and `transmittance` (spectra, default
-//!   0.25), both multiplied by `scale` (float, default 1).
+//! - `"diffusetransmission"`: `reflectance` and `transmittance` (spectra or spectrum
+//!   textures, default 0.25), both multiplied by `scale` (float, default 1).
 //! - `"mix"`: `materials` (two named materials, defined before the mix) and `amount`
 //!   (float, default 0.5): the probability of the second material at a hit.
 //! - `"interface"` (also `""`, `"none"`): no surface.
@@ -276,13 +276,25 @@ impl Parser {
             },
             "diffusetransmission" => {
                 let quarter = Rgb::splat(0.25);
-                let r = self.spectrum_or(ps, "reflectance", SpectrumUse::Albedo, quarter, owner)?;
+                let r =
+                    self.spectrum_texture_param(ps, "reflectance", SpectrumUse::Albedo, quarter)?;
                 let t =
-                    self.spectrum_or(ps, "transmittance", SpectrumUse::Albedo, quarter, owner)?;
+                    self.spectrum_texture_param(ps, "transmittance", SpectrumUse::Albedo, quarter)?;
                 let scale = ps.finite_float("scale", 1.0)?;
-                MaterialDesc::DiffuseTransmission {
-                    reflectance: r * scale,
-                    transmittance: t * scale,
+                match (r, t) {
+                    (TexturedParam::Constant(r), TexturedParam::Constant(t)) => {
+                        MaterialDesc::DiffuseTransmission {
+                            reflectance: r * scale,
+                            transmittance: t * scale,
+                        }
+                    }
+                    (reflectance, transmittance) => {
+                        MaterialDesc::Textured(TexturedMaterialDesc::DiffuseTransmission {
+                            reflectance,
+                            transmittance,
+                            scale,
+                        })
+                    }
                 }
             }
             "mix" => self.mix_material(ps, loc, owner)?,
