@@ -527,7 +527,8 @@ fn bad_values_are_errors_at_their_location() {
             "WorldBegin\nShape \"sphere\" \"float radius\" 1 \"float radius\" 2\n",
             "t.pbrt:2:33:",
         ),
-        ("Scale 1 0 1\n", "t.pbrt:1:1:"),
+        // A singular Scale is accepted with a warning (pbrt-v4); the camera refuses it.
+        ("Scale 1 0 1\nCamera \"perspective\"\n", "t.pbrt:2:1:"),
         ("LookAt 0 0 0  0 0 0  0 1 0\n", "t.pbrt:1:1:"),
         ("Translate 1 2\nWorldBegin\n", "t.pbrt:2:1:"),
         (
