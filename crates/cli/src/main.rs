@@ -7,8 +7,8 @@ mod pbrt_opts;
 mod radiosity_cmd;
 mod render_cmd;
 mod signals;
-mod study_cmd;
 mod slurm_cmd;
+mod study_cmd;
 mod unit_cmd;
 
 use clap::{CommandFactory, Parser, Subcommand};

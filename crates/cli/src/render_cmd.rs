@@ -288,7 +288,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         bail!("--checkpoint and --resume render the whole image, not a unit of it");
     }
     if args.unit.any() && (aovs.any() || variance) {
-        bail!("AOV channels (--aov, Film \"gbuffer\") are written for whole images, not for a unit of one");
+        bail!(
+            "AOV channels (--aov, Film \"gbuffer\") are written for whole images, not for a unit of one"
+        );
     }
     args.unit.load_solution(&mut session, &desc)?;
     let unit = args.unit.apply(&mut session)?;

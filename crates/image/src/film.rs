@@ -78,15 +78,69 @@ impl NonFinite {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sensor {
     pub imaging_ratio: f32,
+    /// Samples whose largest CIE XYZ component, as recorded, is above this are scaled
+    /// down to it (pbrt-v4's `maxcomponentvalue`; infinite: no clamp).
+    pub max_component: f32,
+    /// White balance on the recorded linear sRGB, if any (see
+    /// [`crate::white_balance`]).
+    pub white_balance: Option<[[f32; 3]; 3]>,
 }
 
 impl Sensor {
     /// ISO 100 and a one-second exposure: pixels record radiance as it is.
-    pub const UNIT: Sensor = Sensor { imaging_ratio: 1.0 };
+    pub const UNIT: Sensor = Sensor {
+        imaging_ratio: 1.0,
+        max_component: f32::INFINITY,
+        white_balance: None,
+    };
 
     pub fn new(iso: f32, exposure_time: f32) -> Sensor {
         Sensor {
             imaging_ratio: exposure_time * iso / 100.0,
+            ..Sensor::UNIT
+        }
+    }
+
+    pub fn with_max_component(self, max_component: f32) -> Sensor {
+        Sensor {
+            max_component,
+            ..self
+        }
+    }
+
+    /// Balances the white of daylight at `kelvin` to D65 (`None`: no balance).
+    pub fn with_white_balance(self, kelvin: Option<f32>) -> Sensor {
+        Sensor {
+            white_balance: kelvin.map(crate::white_balance::white_balance),
+            ..self
+        }
+    }
+
+    /// A radiance sample as it goes into a pixel: scaled down so that no XYZ
+    /// component of what the sensor records exceeds `max_component` (its chromaticity
+    /// kept). The identity without a clamp.
+    pub fn clamp_sample(&self, l: Rgb) -> Rgb {
+        if self.max_component == f32::INFINITY {
+            return l;
+        }
+        let xyz = crate::white_balance::apply(&crate::white_balance::XYZ_FROM_RGB, [l.r, l.g, l.b]);
+        let m = xyz[0].max(xyz[1]).max(xyz[2]) * self.imaging_ratio;
+        if m > self.max_component {
+            l * (self.max_component / m)
+        } else {
+            l
+        }
+    }
+
+    /// A pixel's accumulated radiance as the sensor records it.
+    pub fn record(&self, l: Rgb) -> Rgb {
+        let v = l * self.imaging_ratio;
+        match &self.white_balance {
+            None => v,
+            Some(m) => {
+                let [r, g, b] = crate::white_balance::apply(m, [v.r, v.g, v.b]);
+                Rgb::new(r, g, b)
+            }
         }
     }
 }
@@ -149,11 +203,14 @@ impl Film {
 
     /// The current estimate: each pixel's weighted mean, as the sensor records it.
     pub fn image(&self) -> Image {
-        let ratio = self.sensor.imaging_ratio;
         Image {
             width: self.width,
             height: self.height,
-            pixels: self.pixels.iter().map(|p| p.value() * ratio).collect(),
+            pixels: self
+                .pixels
+                .iter()
+                .map(|p| self.sensor.record(p.value()))
+                .collect(),
         }
     }
 
@@ -174,6 +231,23 @@ mod tests {
         p.add(Rgb::splat(4.0), 3.0);
         assert_eq!(p.value(), Rgb::splat(13.0 / 4.0));
         assert_eq!(FilmPixel::default().value(), Rgb::BLACK);
+    }
+
+    #[test]
+    fn max_component_scales_bright_samples_down_keeping_their_colour() {
+        let s = Sensor::new(200.0, 1.0).with_max_component(10.0);
+        // Recorded at twice the radiance: Y of white 8 records 16, scaled to 10.
+        let white = s.clamp_sample(Rgb::splat(8.0));
+        let xyz = crate::white_balance::apply(
+            &crate::white_balance::XYZ_FROM_RGB,
+            [white.r, white.g, white.b],
+        );
+        let m = xyz[0].max(xyz[1]).max(xyz[2]) * 2.0;
+        assert!((m - 10.0).abs() < 1e-4, "{m}");
+        assert!((white.r - white.g).abs() < 1e-6 && (white.g - white.b).abs() < 1e-6);
+        // Dim samples and unclamped sensors pass unchanged.
+        assert_eq!(s.clamp_sample(Rgb::splat(1.0)), Rgb::splat(1.0));
+        assert_eq!(Sensor::UNIT.clamp_sample(Rgb::splat(1e9)), Rgb::splat(1e9));
     }
 
     #[test]

@@ -16,6 +16,7 @@ pub mod png;
 #[cfg(test)]
 mod reference_tests;
 pub mod tiles;
+pub mod white_balance;
 
 use std::path::Path;
 

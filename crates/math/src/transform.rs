@@ -35,6 +35,18 @@ impl Transform {
         inv.is_finite().then_some(Transform { m, inv })
     }
 
+    /// Wraps any finite matrix: a singular one gets a not-a-number inverse (what
+    /// pbrt-v4 does), so that whatever maps through the inverse finds nothing, while
+    /// geometry mapped forwards collapses. [`Transform::is_invertible`] tells them apart.
+    pub fn from_matrix_or_singular(m: Mat4) -> Transform {
+        Transform::from_matrix(m).unwrap_or(Transform { m, inv: Mat4::NAN })
+    }
+
+    /// False for a singular transform (or one composed with a singular one).
+    pub fn is_invertible(&self) -> bool {
+        self.inv.is_finite()
+    }
+
     pub fn translate(d: Vec3) -> Transform {
         Transform {
             m: Mat4::from_translation(d),

@@ -20,8 +20,8 @@ pub mod checkpoint;
 pub mod integrators;
 pub mod partial;
 pub mod session;
-pub mod study;
 pub mod solution;
+pub mod study;
 
 pub use integrators::{INTEGRATOR_NAMES, integrator_from_desc};
 pub use session::Session;

@@ -10,7 +10,8 @@
 //! to the pixel in block order with [`fold`] — the very additions one machine makes.
 //!
 //! A partial file (`RADPART`) is a text header (scene and settings hashes, seed, spp,
-//! resolution, the unit, the part label) and a binary payload of layers, each a sample
+//! resolution, the sensor — imaging ratio, sample clamp, white balance —, the unit, the
+//! part label) and a binary payload of layers, each a sample
 //! range and, per pixel of the unit, the weighted sums (3 × f64), the weight (f64) and
 //! the sample count (u32, dropped non-finite samples included), with the layer's
 //! non-finite sample count and first such pixel; an FNV-1a checksum closes it. It is
@@ -227,6 +228,21 @@ impl Partial {
             "imaging-ratio: {:08x}",
             self.sensor.imaging_ratio.to_bits()
         );
+        let _ = writeln!(
+            header,
+            "max-component: {:08x}",
+            self.sensor.max_component.to_bits()
+        );
+        let balance = match &self.sensor.white_balance {
+            None => "none".to_string(),
+            Some(m) => m
+                .iter()
+                .flatten()
+                .map(|v| format!("{:08x}", v.to_bits()))
+                .collect::<Vec<_>>()
+                .join(","),
+        };
+        let _ = writeln!(header, "white-balance: {balance}");
         let _ = writeln!(header, "pixel-bounds: {}", self.unit.pixels);
         let _ = writeln!(
             header,
@@ -309,8 +325,24 @@ impl Partial {
             spp: num("spp")? as u32,
             resolution: (w, h),
         };
+        let white_balance = match field("white-balance")? {
+            "none" => None,
+            list => {
+                let values: Vec<f32> = list
+                    .split(',')
+                    .map(|v| u32::from_str_radix(v, 16).map(f32::from_bits))
+                    .collect::<Result<_, _>>()
+                    .map_err(|_| bad("white-balance"))?;
+                let [a, b, c, d, e, f, g, h, i] = values[..] else {
+                    return Err(bad("white-balance"));
+                };
+                Some([[a, b, c], [d, e, f], [g, h, i]])
+            }
+        };
         let sensor = Sensor {
             imaging_ratio: f32::from_bits(hex("imaging-ratio")? as u32),
+            max_component: f32::from_bits(hex("max-component")? as u32),
+            white_balance,
         };
         let pixels = parse_pixel_bounds(field("pixel-bounds")?).map_err(|_| bad("pixel-bounds"))?;
         let samples =

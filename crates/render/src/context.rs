@@ -212,7 +212,9 @@ impl RenderContext {
             filter,
             sampler: desc.sampler.kind,
             seed: overrides.seed.unwrap_or(desc.sampler.seed),
-            sensor: Sensor::new(desc.film.iso, 1.0),
+            sensor: Sensor::new(desc.film.iso, 1.0)
+                .with_max_component(desc.film.max_component_value)
+                .with_white_balance(desc.film.white_balance),
             resolution,
             spp,
             work: WorkUnit::full(resolution, spp),

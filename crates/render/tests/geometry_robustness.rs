@@ -341,3 +341,49 @@ fn rays_leaving_spheres_never_hit_them_near_their_origin() {
         }
     }
 }
+
+/// pbrt-v4 accepts singular transforms: a warning with the location, a sphere under a
+/// zero scale left out, a mesh under a flattening matrix kept (flattened), and an
+/// error only where the inverse is needed (the camera).
+#[test]
+fn singular_transforms_are_accepted_with_a_warning_and_collapse_their_shapes() {
+    let dir = std::path::Path::new(".");
+    let text = r#"WorldBegin
+AttributeBegin
+  Scale 0 0 0
+  Shape "sphere" "float radius" 5
+AttributeEnd
+AttributeBegin
+  ConcatTransform [1 0 0 0  0 1 0 0  0 0 0 0  0 0 0 1]
+  Shape "trianglemesh" "integer indices" [0 1 2]
+    "point3 P" [-1 -1 3  1 -1 3  0 1 3]
+AttributeEnd
+"#;
+    let desc = radiant_scene::parse_str(text, "t.pbrt", dir).unwrap_or_else(|e| panic!("{e}"));
+    let singular: Vec<_> = desc
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("singular"))
+        .map(|w| w.to_string())
+        .collect();
+    assert_eq!(singular.len(), 2, "{singular:?}");
+    assert!(singular[0].starts_with("t.pbrt:3:3:"), "{singular:?}");
+    let (world, _) = World::build(&desc).unwrap_or_else(|e| panic!("{e}"));
+    // The triangle, flattened onto z = 0, is hit there; the collapsed sphere nowhere.
+    let down = Ray::new(Vec3::new(0.0, -0.2, 10.0), Vec3::new(0.0, 0.0, -1.0));
+    let hit = world
+        .intersect(&down, f32::INFINITY)
+        .expect("the flattened triangle");
+    assert!(hit.p.z.abs() < 1e-5, "{:?}", hit.p);
+    let beside = Ray::new(Vec3::new(3.0, 0.0, 10.0), Vec3::new(0.0, 0.0, -1.0));
+    assert!(world.intersect(&beside, f32::INFINITY).is_none());
+
+    let camera = "Scale 1 0 1\nCamera \"perspective\"\nWorldBegin\n";
+    let e = radiant_scene::parse_str(camera, "t.pbrt", dir)
+        .expect_err("the camera needs the inverse")
+        .to_string();
+    assert!(
+        e.starts_with("t.pbrt:2:1:") && e.contains("singular"),
+        "{e}"
+    );
+}

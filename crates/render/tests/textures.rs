@@ -432,3 +432,69 @@ fn mappings_give_their_closed_form_coordinates() {
         st("cylinder", &ctx)
     );
 }
+
+#[test]
+fn coated_diffuse_reads_its_reflectance_texture_at_each_hit() {
+    use radiant_render::geometry::Ray;
+    let dir = temp_dir("coated");
+    let scene = |reflectance: &str| {
+        format!(
+            r#"WorldBegin
+Texture "c" "spectrum" "checkerboard" "rgb tex1" [0.9 0.9 0.9] "rgb tex2" [0.1 0.1 0.1]
+Material "coateddiffuse" {reflectance} "float roughness" 0.1
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point3 P" [0 0 0  1 0 0  1 1 0  0 1 0] "point2 uv" [0 0 2 0 2 2 0 2]
+"#
+        )
+    };
+    let albedo_at = |desc: &SceneDesc, x: f32, y: f32| {
+        let (world, _) = World::build(desc).unwrap_or_else(|e| panic!("{e}"));
+        let ray = Ray::new(Vec3::new(x, y, 1.0), Vec3::new(0.0, 0.0, -1.0));
+        let hit = world.intersect(&ray, f32::INFINITY).expect("the square");
+        world.material_at(&hit, Vec3::Z).diffuse_albedo()
+    };
+    let textured = parse_in(&scene(r#""texture reflectance" "c""#), &dir);
+    assert!(textured.warnings.is_empty(), "{:?}", textured.warnings);
+    // uv spans [0, 2]²: (0.25, 0.25) is in check (0, 0) (tex1), (0.75, 0.25) in (1, 0).
+    let light = parse_in(&scene(r#""rgb reflectance" [0.9 0.9 0.9]"#), &dir);
+    let dark = parse_in(&scene(r#""rgb reflectance" [0.1 0.1 0.1]"#), &dir);
+    assert_eq!(
+        albedo_at(&textured, 0.25, 0.25),
+        albedo_at(&light, 0.25, 0.25)
+    );
+    assert_eq!(
+        albedo_at(&textured, 0.75, 0.25),
+        albedo_at(&dark, 0.75, 0.25)
+    );
+    assert!(albedo_at(&light, 0.5, 0.5).r > 2.0 * albedo_at(&dark, 0.5, 0.5).r);
+}
+
+#[test]
+fn diffuse_transmission_reads_its_textures_at_each_hit_times_scale() {
+    use radiant_render::geometry::Ray;
+    use radiant_render::material::Material;
+    let dir = temp_dir("transmission");
+    let desc = parse_in(
+        r#"WorldBegin
+Texture "c" "spectrum" "checkerboard" "rgb tex1" [0.8 0.8 0.8] "rgb tex2" [0.2 0.2 0.2]
+Material "diffusetransmission" "texture reflectance" "c" "rgb transmittance" [0.4 0.4 0.4]
+  "float scale" 0.5
+Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
+  "point3 P" [0 0 0  1 0 0  1 1 0  0 1 0] "point2 uv" [0 0 2 0 2 2 0 2]
+"#,
+        &dir,
+    );
+    assert!(desc.warnings.is_empty(), "{:?}", desc.warnings);
+    let (world, _) = World::build(&desc).unwrap_or_else(|e| panic!("{e}"));
+    let at = |x: f32, y: f32| {
+        let ray = Ray::new(Vec3::new(x, y, 1.0), Vec3::new(0.0, 0.0, -1.0));
+        let hit = world.intersect(&ray, f32::INFINITY).expect("the square");
+        world.material_at(&hit, Vec3::Z)
+    };
+    let want = |r: f32| Material::DiffuseTransmission {
+        reflectance: Rgb::splat(r * 0.5),
+        transmittance: Rgb::splat(0.2),
+    };
+    assert_eq!(at(0.25, 0.25), want(0.8));
+    assert_eq!(at(0.75, 0.25), want(0.2));
+}

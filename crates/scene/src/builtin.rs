@@ -73,6 +73,7 @@ fn sphere(center: Vec3, radius: f32, material: MaterialId, scene: &str) -> Shape
         reverse_orientation: false,
         material,
         area_light: None,
+        alpha: None,
         loc: loc(scene),
     }
 }
@@ -114,6 +115,8 @@ fn canonical_settings(
             diagonal_mm: 35.0,
             iso: 100.0,
             gbuffer: None,
+            max_component_value: f32::INFINITY,
+            white_balance: None,
             loc: loc(scene),
         },
         SamplerDesc {
@@ -371,6 +374,7 @@ fn assemble(
         filter,
         integrator,
         materials,
+        shading_normals: Vec::new(),
         textures: Vec::new(),
         shapes,
         objects: Vec::new(),

@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 
 use super::error::{FileLoc, Warning};
 use super::params::ParamSet;
-use super::texture::{TextureDesc, TexturedMaterialDesc};
+use super::texture::{FloatParam, ShadingNormalDesc, TextureDesc, TexturedMaterialDesc};
 use radiant_math::Transform;
 use radiant_math::color::Rgb;
 
@@ -24,6 +24,9 @@ pub struct SceneDesc {
     pub filter: FilterDesc,
     pub integrator: IntegratorDesc,
     pub materials: Vec<MaterialDesc>,
+    /// Bump or normal map of material i, at index i; shorter than `materials` when the
+    /// last ones have none (read it with [`SceneDesc::shading_normal`]).
+    pub shading_normals: Vec<Option<ShadingNormalDesc>>,
     /// Named textures, referred to by index from textured materials and other textures.
     pub textures: Vec<TextureDesc>,
     pub shapes: Vec<ShapeDesc>,
@@ -35,6 +38,13 @@ pub struct SceneDesc {
     pub warnings: Vec<Warning>,
     /// The scene file, when the scene came from one (relative paths resolve from its folder).
     pub source: Option<PathBuf>,
+}
+
+impl SceneDesc {
+    /// The bump or normal map of material `id`, if it has one.
+    pub fn shading_normal(&self, id: MaterialId) -> Option<&ShadingNormalDesc> {
+        self.shading_normals.get(id as usize)?.as_ref()
+    }
 }
 
 /// `Camera`: where it is and how it forms the image.
@@ -86,6 +96,12 @@ pub struct FilmDesc {
     pub iso: f32,
     /// `Film "gbuffer"`: the image is written with its G-buffer channels.
     pub gbuffer: Option<GBufferSpace>,
+    /// `maxcomponentvalue`: a sample whose largest CIE XYZ component (as the sensor
+    /// records it) is above this is scaled down to it. Infinite by default.
+    pub max_component_value: f32,
+    /// `whitebalance`: the colour temperature (K) of the CIE daylight illuminant that
+    /// is mapped to the output's white (D65); `None`: no white balance.
+    pub white_balance: Option<f32>,
     pub loc: FileLoc,
 }
 
@@ -290,6 +306,10 @@ pub struct ShapeDesc {
     pub reverse_orientation: bool,
     pub material: MaterialId,
     pub area_light: Option<AreaLightDesc>,
+    /// pbrt-v4's `alpha` cut-out: where it is 0 rays pass through the shape as if it
+    /// were not there, where fractional they pass with probability 1 − alpha. `None`
+    /// for an opaque shape (alpha 1).
+    pub alpha: Option<FloatParam>,
     pub loc: FileLoc,
 }
 
@@ -315,6 +335,7 @@ impl ShapeDesc {
             reverse_orientation: false,
             material,
             area_light: None,
+            alpha: None,
             loc,
         }
     }

@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use glam::Vec3;
 
-use crate::desc::ConductorDesc;
+use crate::desc::{CoatDesc, ConductorDesc};
 use crate::error::FileLoc;
 use radiant_math::Transform;
 use radiant_math::color::Rgb;
@@ -226,6 +226,30 @@ pub enum TexturedMaterialDesc {
         conductor: ConductorDesc,
         roughness: RoughnessDesc,
     },
+    /// `diffusetransmission` with a textured `reflectance` or `transmittance`, each
+    /// multiplied by `scale` (then clamped to [0, 1]).
+    DiffuseTransmission {
+        reflectance: SpectrumParam,
+        transmittance: SpectrumParam,
+        scale: f32,
+    },
+    /// `coateddiffuse` with a textured base `reflectance` (clamped to [0, 1]).
+    CoatedDiffuse {
+        reflectance: SpectrumParam,
+        coat: CoatDesc,
+    },
+}
+
+/// How a material tilts the shading normal before its BSDF is evaluated.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShadingNormalDesc {
+    /// `displacement`: a float texture read as a height along the shading normal; the
+    /// normal is that of the displaced surface, from finite differences in (u, v)
+    /// (Blinn 1978, "Simulation of wrinkled surfaces").
+    Bump { displacement: TextureId },
+    /// `normalmap`: an image (read as linear) whose RGB in [0, 1] encodes a unit normal
+    /// in the tangent frame (∂p/∂u, n × ∂p/∂u, n) as 2 RGB − 1, looked up at (u, 1 − v).
+    NormalMap { filename: PathBuf },
 }
 
 /// Microfacet roughness along the two tangent axes, possibly textured. With

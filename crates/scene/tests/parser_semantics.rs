@@ -113,13 +113,13 @@ fn realistic_camera_resolves_its_lens_file_from_the_scene_folder() {
 #[test]
 fn unused_and_unsupported_parameters_warn_with_their_location() {
     let s = parse(
-        "Film \"rgb\" \"float whitebalance\" 5500 \"bool savefp16\" true\nWorldBegin\n\
+        "Film \"rgb\" \"float exposuretime\" 5500 \"bool savefp16\" true\nWorldBegin\n\
          Shape \"sphere\" \"float radius\" 2\n      \"float radisu\" 3\n",
     );
     let msgs: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
     assert_eq!(msgs.len(), 3, "{msgs:#?}");
-    assert!(msgs[0].starts_with("t.pbrt:1:12: warning: Film: parameter \"whitebalance\""));
-    assert!(msgs[1].starts_with("t.pbrt:1:38: warning: Film: parameter \"savefp16\""));
+    assert!(msgs[1].starts_with("t.pbrt:1:12: warning: Film: parameter \"exposuretime\""));
+    assert!(msgs[0].starts_with("t.pbrt:1:38: warning: Film: parameter \"savefp16\""));
     assert_eq!(
         msgs[2],
         "t.pbrt:4:7: warning: parameter \"float radisu\" is not used by Shape \"sphere\""
@@ -527,7 +527,8 @@ fn bad_values_are_errors_at_their_location() {
             "WorldBegin\nShape \"sphere\" \"float radius\" 1 \"float radius\" 2\n",
             "t.pbrt:2:33:",
         ),
-        ("Scale 1 0 1\n", "t.pbrt:1:1:"),
+        // A singular Scale is accepted with a warning (pbrt-v4); the camera refuses it.
+        ("Scale 1 0 1\nCamera \"perspective\"\n", "t.pbrt:2:1:"),
         ("LookAt 0 0 0  0 0 0  0 1 0\n", "t.pbrt:1:1:"),
         ("Translate 1 2\nWorldBegin\n", "t.pbrt:2:1:"),
         (
@@ -600,4 +601,37 @@ fn infinite_light_with_an_image() {
     };
     assert_eq!(image.illuminance, Some(7.0));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn film_sensor_white_balance_and_max_component_value() {
+    let d = parse("Film \"rgb\"\nWorldBegin\n");
+    assert_eq!(d.film.max_component_value, f32::INFINITY);
+    assert_eq!(d.film.white_balance, None);
+
+    let d = parse(
+        "Film \"rgb\" \"float maxcomponentvalue\" 10 \"string sensor\" \"cie1931\" \"float whitebalance\" 5000\nWorldBegin\n",
+    );
+    assert_eq!(d.film.max_component_value, 10.0);
+    assert_eq!(d.film.white_balance, Some(5000.0));
+    assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+
+    // A camera sensor: read through the CIE observer, with a warning, and white-balanced
+    // to 6500 K as pbrt-v4 does for camera sensors.
+    let d = parse("Film \"rgb\" \"string sensor\" \"canon_eos_100d\"\nWorldBegin\n");
+    assert_eq!(d.film.white_balance, Some(6500.0));
+    assert_eq!(d.warnings.len(), 1, "{:?}", d.warnings);
+    assert!(d.warnings[0].message.contains("CIE 1931"));
+    let d = parse("Film \"rgb\" \"string sensor\" \"my_camera\"\nWorldBegin\n");
+    assert!(
+        d.warnings[0]
+            .message
+            .contains("unknown sensor \"my_camera\"")
+    );
+
+    assert!(
+        err("Film \"rgb\" \"float maxcomponentvalue\" 0\nWorldBegin\n")
+            .contains("maxcomponentvalue")
+    );
+    assert!(err("Film \"rgb\" \"float whitebalance\" -1\nWorldBegin\n").contains("whitebalance"));
 }

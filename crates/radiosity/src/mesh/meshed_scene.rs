@@ -67,6 +67,21 @@ fn diffuse_albedos(materials: &[MaterialDesc], textures: &TextureSet) -> Vec<[f6
             Some(MaterialDesc::Textured(TexturedMaterialDesc::Diffuse { reflectance })) => {
                 clamp(textures.uv_average(*reflectance, TEXTURE_AVERAGE_GRID))
             }
+            Some(MaterialDesc::Textured(TexturedMaterialDesc::DiffuseTransmission {
+                reflectance,
+                scale,
+                ..
+            })) => clamp(textures.uv_average(*reflectance, TEXTURE_AVERAGE_GRID) * *scale),
+            Some(MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse {
+                reflectance,
+                coat,
+            })) => {
+                let d = MaterialDesc::CoatedDiffuse {
+                    reflectance: textures.uv_average(*reflectance, TEXTURE_AVERAGE_GRID),
+                    coat: *coat,
+                };
+                clamp(radiant_render::material::Material::from_desc(&d).diffuse_albedo())
+            }
             Some(MaterialDesc::Mix {
                 materials: m,
                 amount,
@@ -103,6 +118,10 @@ fn material_type(m: &MaterialDesc) -> &'static str {
         MaterialDesc::Textured(TexturedMaterialDesc::Diffuse { .. }) => "diffuse",
         MaterialDesc::Textured(TexturedMaterialDesc::RoughDielectric { .. }) => "dielectric",
         MaterialDesc::Textured(TexturedMaterialDesc::RoughConductor { .. }) => "conductor",
+        MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse { .. }) => "coateddiffuse",
+        MaterialDesc::Textured(TexturedMaterialDesc::DiffuseTransmission { .. }) => {
+            "diffusetransmission"
+        }
         MaterialDesc::Interface => "interface",
     }
 }

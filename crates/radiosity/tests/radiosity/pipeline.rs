@@ -279,6 +279,7 @@ fn curved_bilinear_patches_are_meshed_on_their_surface() {
         reverse_orientation: false,
         material,
         area_light,
+        alpha: None,
         loc: FileLoc::builtin("test"),
     };
     desc.materials = vec![MaterialDesc::Diffuse {

@@ -190,7 +190,9 @@ fn render_pass<E: PixelEstimator>(
         pixels, moments, ..
     } = film;
     let row = |row_index: usize, row: &mut [FilmPixel], moments: Option<&mut [[f64; 3]]>| {
-        render_row(ctx, estimator, row_index, row, moments, first, count, progress)
+        render_row(
+            ctx, estimator, row_index, row, moments, first, count, progress,
+        )
     };
     match moments {
         None => pixels
@@ -244,6 +246,7 @@ fn render_row<E: PixelEstimator>(
                 &mut open
             };
             if l.is_finite() && weight.is_finite() {
+                let l = ctx.sensor.clamp_sample(l);
                 target.add(l, weight);
                 if let Some(m) = moments.as_deref_mut() {
                     for (s, v) in m[column].iter_mut().zip(l.to_array()) {

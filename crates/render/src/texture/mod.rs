@@ -310,6 +310,18 @@ pub fn concrete_material(
                 alpha_v,
             }
         }
+        TexturedMaterialDesc::DiffuseTransmission {
+            reflectance,
+            transmittance,
+            scale,
+        } => MaterialDesc::DiffuseTransmission {
+            reflectance: spectrum(*reflectance) * *scale,
+            transmittance: spectrum(*transmittance) * *scale,
+        },
+        TexturedMaterialDesc::CoatedDiffuse { reflectance, coat } => MaterialDesc::CoatedDiffuse {
+            reflectance: spectrum(*reflectance),
+            coat: *coat,
+        },
     };
     Material::from_desc(&plain)
 }

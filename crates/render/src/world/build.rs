@@ -62,6 +62,7 @@ impl World {
             })
             .collect();
         let materials = material_table(&desc.materials, &textures)?;
+        let shading_normals = super::normals::build_shading_normals(desc)?;
         let mut lights = Vec::new();
 
         let mut prototypes = Vec::with_capacity(desc.objects.len());
@@ -86,7 +87,8 @@ impl World {
             )?;
         }
         for inst in &desc.instances {
-            if prototypes[inst.object].is_empty() {
+            // A singular instance transform has collapsed the object.
+            if prototypes[inst.object].is_empty() || !inst.render_from_instance.is_invertible() {
                 continue;
             }
             let i = top.instances.len() as u32;
@@ -110,6 +112,12 @@ impl World {
             materials,
             textured,
             textures,
+            shading_normals,
+            cut_outs: desc
+                .shapes
+                .iter()
+                .chain(desc.objects.iter().flat_map(|o| o.shapes.iter()))
+                .any(|s| s.alpha.is_some()),
             ray_spread: RaySpread::NONE,
             lights,
             light_sampler,
@@ -457,6 +465,7 @@ fn add_shape(
                     material,
                     light,
                     orientation,
+                    alpha: shape.alpha,
                 });
                 set.prims.push(PrimRef::Bilinear(i));
             }
@@ -472,6 +481,9 @@ fn add_shape(
                 mesh.bilinear_halves = true;
             }
         }
+        // Quadrics are intersected in object space: under a singular transform (which
+        // the parser accepted with a warning) they have collapsed and are left out.
+        Geometry::Sphere { .. } | Geometry::Disk { .. } if !xf.is_invertible() => {}
         Geometry::Sphere {
             radius,
             z_min,
@@ -501,6 +513,7 @@ fn add_shape(
                 material,
                 light,
                 reverse: ro,
+                alpha: shape.alpha,
             });
             set.prims.push(PrimRef::Sphere(i));
         }
@@ -535,6 +548,7 @@ fn add_shape(
                 material,
                 light,
                 reverse: ro,
+                alpha: shape.alpha,
             });
             set.prims.push(PrimRef::Disk(i));
         }
@@ -664,5 +678,6 @@ fn add_mesh(
         normals: n,
         uvs: uvs.clone(),
         bilinear_halves: false,
+        alpha: shape.alpha,
     });
 }

@@ -5,11 +5,13 @@
 //! lazy expansion of a hit into a [`SurfaceHit`] with positions, normals and uvs.
 
 mod build;
+mod normals;
 mod shapes;
 
 use glam::{Vec2, Vec3};
 
 pub use build::BuildError;
+pub use normals::ShadingNormal;
 pub use shapes::ShapeSet;
 
 use crate::camera::RaySpread;
@@ -20,7 +22,7 @@ use crate::texture::{TextureEvalContext, TextureSet};
 use radiant_math::Frame;
 use radiant_math::color::Rgb;
 use radiant_math::hash::{hash_u64s, u32_to_unit_f32};
-use radiant_scene::TexturedMaterialDesc;
+use radiant_scene::{FloatParam, TexturedMaterialDesc};
 
 /// No light attached (in per-primitive light indices).
 pub const NO_LIGHT: u32 = u32::MAX;
@@ -51,6 +53,8 @@ pub struct SurfaceHit {
     pub material: u32,
     /// Index of the area light of this primitive, or [`NO_LIGHT`].
     pub light: u32,
+    /// The shape's `alpha` cut-out, `None` when opaque.
+    pub alpha: Option<FloatParam>,
 }
 
 impl SurfaceHit {
@@ -105,6 +109,10 @@ pub enum MaterialEntry {
 /// refuses cycles; this is the backstop).
 pub(crate) const MAX_MIX_DEPTH: usize = 64;
 
+/// Bound on the cut-out surfaces one ray passes, so that stacks of coplanar cut-outs
+/// cannot loop.
+const MAX_CUT_OUT_CROSSINGS: usize = 256;
+
 /// Everything an integrator traces against.
 pub struct World {
     pub(crate) geometry: ShapeSet,
@@ -117,6 +125,11 @@ pub struct World {
     /// The textured description of each material id that has one.
     pub(crate) textured: Vec<Option<TexturedMaterialDesc>>,
     pub textures: TextureSet,
+    /// Bump or normal map by material id (empty when none has one); applied to every
+    /// hit [`World::intersect`] returns.
+    pub(crate) shading_normals: Vec<Option<ShadingNormal>>,
+    /// Some shape has an `alpha` cut-out: rays then test each hit's alpha.
+    pub(crate) cut_outs: bool,
     /// The camera's pixel footprint along paths, for texture filtering.
     pub ray_spread: RaySpread,
     pub lights: Vec<Light>,
@@ -127,15 +140,89 @@ pub struct World {
 
 impl World {
     /// Closest hit in `(0, t_max)`.
+    /// The shading normal is that of the hit's material (bump or normal map applied).
+    /// Hits that an alpha cut-out lets through are skipped.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
         crate::stats::add(crate::stats::Counter::ClosestHitTests, 1);
-        self.geometry.intersect(ray, t_max, &self.prototypes)
+        let mut hit = if self.cut_outs {
+            self.intersect_through_cut_outs(ray, t_max)?
+        } else {
+            self.geometry.intersect(ray, t_max, &self.prototypes)?
+        };
+        if !self.shading_normals.is_empty() {
+            self.perturb_shading_normal(&mut hit, -ray.d.normalize());
+        }
+        Some(hit)
     }
 
-    /// True when anything blocks the ray in `(0, t_max)`.
+    /// Tilts `hit.ns` by the bump or normal map of the material that shades it seen
+    /// from `wo_world` (for a mix, the chosen material's).
+    fn perturb_shading_normal(&self, hit: &mut SurfaceHit, wo_world: Vec3) {
+        let index = self.resolve_index(hit.material, hit.p, wo_world);
+        if let Some(Some(normal)) = self.shading_normals.get(index as usize) {
+            normals::perturb(hit, normal, &self.textures);
+        }
+    }
+
+    /// True when anything blocks the ray in `(0, t_max)` (alpha cut-outs let it
+    /// through where [`World::intersect`] would).
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         crate::stats::add(crate::stats::Counter::ShadowTests, 1);
-        self.geometry.occluded(ray, t_max, &self.prototypes)
+        if self.cut_outs {
+            self.intersect_through_cut_outs(ray, t_max).is_some()
+        } else {
+            self.geometry.occluded(ray, t_max, &self.prototypes)
+        }
+    }
+
+    /// The closest hit whose alpha keeps it: after a hit the ray goes on from just past
+    /// it (its error bound), `t` of the result measured along the original ray.
+    fn intersect_through_cut_outs(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
+        let mut r = *ray;
+        let mut t_base = 0.0f32;
+        for _ in 0..MAX_CUT_OUT_CROSSINGS {
+            let mut hit = self
+                .geometry
+                .intersect(&r, t_max - t_base, &self.prototypes)?;
+            if !self.cut_out(&hit, ray.d) {
+                hit.t += t_base;
+                return Some(hit);
+            }
+            let o = hit.spawn_origin(ray.d);
+            t_base += (o - r.o).dot(ray.d) / ray.d.length_squared();
+            if t_base >= t_max || t_base.is_nan() {
+                return None;
+            }
+            r = Ray::new(o, ray.d);
+        }
+        // So many layers of fractional alpha pass (almost) nothing: opaque.
+        self.geometry
+            .intersect(&r, t_max - t_base, &self.prototypes)
+    }
+
+    /// Whether the alpha of `hit` lets a ray of direction `d` through: always where
+    /// alpha ≤ 0, never where it is ≥ 1, and in between when a hash of the point and
+    /// direction, uniform in [0, 1), is at least alpha (so with probability 1 − alpha,
+    /// the same for every ray that meets the same point from the same direction).
+    pub fn cut_out(&self, hit: &SurfaceHit, d: Vec3) -> bool {
+        let Some(alpha) = hit.alpha else {
+            return false;
+        };
+        let a = self
+            .textures
+            .float(alpha, &TextureEvalContext::from_hit(hit));
+        if a >= 1.0 {
+            return false;
+        }
+        if a <= 0.0 || a.is_nan() {
+            return true;
+        }
+        let d = d.normalize();
+        let bits = |v: Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()].map(u64::from);
+        let [px, py, pz] = bits(hit.p);
+        let [dx, dy, dz] = bits(d);
+        let h = hash_u64s(&[px, py, pz, dx, dy, dz, 0xa1fa]);
+        u32_to_unit_f32((h >> 32) as u32) >= a
     }
 
     /// True when the segment between two points is free: each end is moved off its own

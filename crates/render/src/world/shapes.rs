@@ -10,6 +10,7 @@ use crate::geometry::ray::{barycentric_error, transform_point_with_error};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::{Aabb, Ray};
 use radiant_math::Transform;
+use radiant_scene::FloatParam;
 
 /// Which array a primitive of the generic BVH lives in, and its index there.
 /// Triangles have their own SIMD BVH and never appear here.
@@ -45,6 +46,8 @@ pub(crate) struct MeshAttrs {
     /// bilinear patches, in pairs: without `uvs` they take the patch's parameterisation
     /// (corners (0,0), (1,0), (0,1), (1,1), as pbrt-v4 gives a bilinear patch).
     pub bilinear_halves: bool,
+    /// The shape's `alpha` cut-out, if any.
+    pub alpha: Option<FloatParam>,
 }
 
 /// A quadric placed in render space.
@@ -56,6 +59,7 @@ pub(crate) struct Placed<S> {
     pub light: u32,
     /// ReverseOrientation: the front (emitting) side is the inside.
     pub reverse: bool,
+    pub alpha: Option<FloatParam>,
 }
 
 /// A curved bilinear patch in render space.
@@ -66,6 +70,7 @@ pub(crate) struct BilinearPrim {
     pub light: u32,
     /// −1 when the front is opposite ∂p/∂u × ∂p/∂v (ReverseOrientation xor a mirror).
     pub orientation: f32,
+    pub alpha: Option<FloatParam>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -395,6 +400,7 @@ impl ShapeSet {
                     dpdy: Vec3::ZERO,
                     material: b.material,
                     light: b.light,
+                    alpha: b.alpha,
                 }
             }
             RawHit::Quadric {
@@ -404,7 +410,7 @@ impl ShapeSet {
                 n_obj,
                 uv,
             } => {
-                let (xf, material, light, reverse, phi_max) = match prim {
+                let (xf, material, light, reverse, phi_max, alpha) = match prim {
                     PrimRef::Sphere(i) => {
                         let s = &self.spheres[i as usize];
                         let phi_max = s.shape.phi_max;
@@ -414,6 +420,7 @@ impl ShapeSet {
                             s.light,
                             s.reverse,
                             phi_max,
+                            s.alpha,
                         )
                     }
                     PrimRef::Disk(i) => {
@@ -425,6 +432,7 @@ impl ShapeSet {
                             d.light,
                             d.reverse,
                             phi_max,
+                            d.alpha,
                         )
                     }
                     _ => unreachable!("bilinear patches are handled above; instances are resolved"),
@@ -449,6 +457,7 @@ impl ShapeSet {
                     dpdy: Vec3::ZERO,
                     material,
                     light,
+                    alpha,
                 }
             }
         }
@@ -505,6 +514,7 @@ impl ShapeSet {
             dpdy: Vec3::ZERO,
             material: attr.material,
             light: attr.light,
+            alpha: mesh.alpha,
         }
     }
 }

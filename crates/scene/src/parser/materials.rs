@@ -6,8 +6,8 @@
 //! - `"conductor"`: `reflectance` (an artist's mirror colour), else `eta` and `k`
 //!   (spectra; default copper, `metal-Cu-eta` / `metal-Cu-k`).
 //! - `"thindielectric"`: `eta` as for `dielectric` (default 1.5).
-//! - `"diffusetransmission"`: `reflectance` and `transmittance` (spectra, default
-//!   0.25), both multiplied by `scale` (float, default 1).
+//! - `"diffusetransmission"`: `reflectance` and `transmittance` (spectra or spectrum
+//!   textures, default 0.25), both multiplied by `scale` (float, default 1).
 //! - `"mix"`: `materials` (two named materials, defined before the mix) and `amount`
 //!   (float, default 0.5): the probability of the second material at a hit.
 //! - `"interface"` (also `""`, `"none"`): no surface.
@@ -19,7 +19,7 @@
 //!   alphas below its smooth threshold a delta BSDF). Roughness may be a float
 //!   texture.
 //! - `"coateddiffuse"`: a dielectric coat over a Lambertian base: `reflectance`
-//!   (0.5), the coat's `roughness` / `uroughness` / `vroughness` (0) and
+//!   (0.5, or a spectrum texture), the coat's `roughness` / `uroughness` / `vroughness` (0) and
 //!   `remaproughness` as above, `eta` (1.5, as for `dielectric`), and the slab between:
 //!   `thickness` (0.01), medium `albedo` (0) and Henyey–Greenstein `g` (0), random
 //!   walk `maxdepth` (10) and `nsamples` (1).
@@ -30,6 +30,9 @@
 //!   default copper, or `reflectance`; `conductor.roughness`, ...).
 //! - Textured floats of the layered materials (`thickness`, `g`, roughness) are
 //!   reported and read as their defaults.
+//! - Any material takes `displacement` (a float texture: bump mapping) or
+//!   `normalmap` (an image file, relative to the scene file); see
+//!   [`crate::ShadingNormalDesc`].
 //! - A material with a texture-valued parameter becomes [`MaterialDesc::Textured`];
 //!   one whose parameters are all constant keeps its plain variant.
 //! - Other material types render as diffuse 0.5 with a warning.
@@ -42,7 +45,9 @@ use crate::error::{FileLoc, SceneError};
 use crate::named_spectra::{glass_eta, metal_spectrum};
 use crate::params::{ParamSet, ParamValue};
 use crate::spectrum::{interpolate, pairs_from_flat};
-use crate::texture::{FloatParam, RoughnessDesc, TexturedMaterialDesc, TexturedParam};
+use crate::texture::{
+    FloatParam, RoughnessDesc, ShadingNormalDesc, TexturedMaterialDesc, TexturedParam,
+};
 use radiant_math::color::Rgb;
 
 /// pbrt-v4's material types that radiant replaces by diffuse 0.5.
@@ -58,9 +63,12 @@ impl Parser {
         let ps = with_defaults(self.param_list()?, &self.gs.defaults.material);
         self.require_world("Material", loc)?;
         let owner = format!("Material \"{ty}\"");
+        let normal = self.shading_normal_param(&ps)?;
         let m = self.build_material(&ty, &ps, loc, &owner)?;
         self.report_unused(&ps, &owner);
-        self.gs.material = Some(self.push_material(m));
+        let id = self.push_material(m);
+        self.set_shading_normal(id, normal);
+        self.gs.material = Some(id);
         Ok(())
     }
 
@@ -86,9 +94,11 @@ impl Parser {
                 format!("named material \"{name}\" is defined twice"),
             ));
         }
+        let normal = self.shading_normal_param(&ps)?;
         let m = self.build_material(&ty, &ps, loc, &owner)?;
         self.report_unused(&ps, &owner);
         let id = self.push_material(m);
+        self.set_shading_normal(id, normal);
         self.named_materials.insert(name, id);
         Ok(())
     }
@@ -111,6 +121,48 @@ impl Parser {
                 format!("unknown named material \"{name}\""),
             )),
         }
+    }
+
+    /// `normalmap` (an image file) or `displacement` (a float texture; a constant
+    /// displacement moves the surface without tilting it, so it is dropped). A normal
+    /// map wins over a displacement, as in pbrt-v4.
+    fn shading_normal_param(
+        &mut self,
+        ps: &ParamSet,
+    ) -> Result<Option<ShadingNormalDesc>, SceneError> {
+        let displacement = self.float_texture_param(ps, "displacement", 0.0)?;
+        if let Some((names, at)) = ps.strings("normalmap")? {
+            let [written] = names else {
+                return Err(SceneError::at(at, "\"string normalmap\" needs one value"));
+            };
+            if written.is_empty() {
+                return Ok(None);
+            }
+            let at = at.clone();
+            let filename = self.resolve_path(written);
+            if !filename.is_file() {
+                return Err(SceneError::at(
+                    &at,
+                    format!("normal map '{}' not found", filename.display()),
+                ));
+            }
+            return Ok(Some(ShadingNormalDesc::NormalMap { filename }));
+        }
+        Ok(match displacement {
+            TexturedParam::Texture(displacement) => Some(ShadingNormalDesc::Bump { displacement }),
+            TexturedParam::Constant(_) => None,
+        })
+    }
+
+    fn set_shading_normal(&mut self, id: MaterialId, normal: Option<ShadingNormalDesc>) {
+        if normal.is_none() {
+            return;
+        }
+        let i = id as usize;
+        if self.shading_normals.len() <= i {
+            self.shading_normals.resize(i + 1, None);
+        }
+        self.shading_normals[i] = normal;
     }
 
     fn push_material(&mut self, m: MaterialDesc) -> MaterialId {
@@ -142,15 +194,6 @@ impl Parser {
         loc: &FileLoc,
         owner: &str,
     ) -> Result<MaterialDesc, SceneError> {
-        for unsupported in ["displacement", "normalmap"] {
-            if let Some(p) = ps.lookup(unsupported) {
-                let at = p.loc.clone();
-                self.warn(
-                    &at,
-                    format!("{owner}: \"{unsupported}\" is not supported; ignored"),
-                );
-            }
-        }
         Ok(match ty {
             "diffuse" => match self.spectrum_texture_param(
                 ps,
@@ -199,16 +242,24 @@ impl Parser {
                     }
                 }
             }
-            "coateddiffuse" => MaterialDesc::CoatedDiffuse {
-                reflectance: self.spectrum_or(
+            "coateddiffuse" => {
+                let reflectance = self.spectrum_texture_param(
                     ps,
                     "reflectance",
                     SpectrumUse::Albedo,
                     Rgb::splat(0.5),
-                    owner,
-                )?,
-                coat: self.coat_desc(ps, "", loc, owner)?,
-            },
+                )?;
+                let coat = self.coat_desc(ps, "", loc, owner)?;
+                match reflectance {
+                    TexturedParam::Constant(reflectance) => {
+                        MaterialDesc::CoatedDiffuse { reflectance, coat }
+                    }
+                    reflectance => MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse {
+                        reflectance,
+                        coat,
+                    }),
+                }
+            }
             "coatedconductor" => {
                 let coat = self.coat_desc(ps, "interface.", loc, owner)?;
                 let (alpha_u, alpha_v) = self.constant_alpha(ps, "conductor.", owner)?;
@@ -225,13 +276,25 @@ impl Parser {
             },
             "diffusetransmission" => {
                 let quarter = Rgb::splat(0.25);
-                let r = self.spectrum_or(ps, "reflectance", SpectrumUse::Albedo, quarter, owner)?;
+                let r =
+                    self.spectrum_texture_param(ps, "reflectance", SpectrumUse::Albedo, quarter)?;
                 let t =
-                    self.spectrum_or(ps, "transmittance", SpectrumUse::Albedo, quarter, owner)?;
+                    self.spectrum_texture_param(ps, "transmittance", SpectrumUse::Albedo, quarter)?;
                 let scale = ps.finite_float("scale", 1.0)?;
-                MaterialDesc::DiffuseTransmission {
-                    reflectance: r * scale,
-                    transmittance: t * scale,
+                match (r, t) {
+                    (TexturedParam::Constant(r), TexturedParam::Constant(t)) => {
+                        MaterialDesc::DiffuseTransmission {
+                            reflectance: r * scale,
+                            transmittance: t * scale,
+                        }
+                    }
+                    (reflectance, transmittance) => {
+                        MaterialDesc::Textured(TexturedMaterialDesc::DiffuseTransmission {
+                            reflectance,
+                            transmittance,
+                            scale,
+                        })
+                    }
                 }
             }
             "mix" => self.mix_material(ps, loc, owner)?,

@@ -31,7 +31,7 @@ use glam::Vec2;
 use super::desc::*;
 use super::error::{FileLoc, SceneError, Warning};
 use super::params::{ParamSet, ParamValue};
-use super::texture::{TextureDesc, TextureId, TextureType};
+use super::texture::{ShadingNormalDesc, TextureDesc, TextureId, TextureType};
 use super::token::{Lexer, Token, TokenKind};
 use radiant_math::Transform;
 use state::{GraphicsState, SavedState};
@@ -200,6 +200,8 @@ pub(super) struct Parser {
     filter: Option<FilterDesc>,
     integrator: Option<IntegratorDesc>,
     materials: Vec<MaterialDesc>,
+    /// Bump or normal map per material id (see `SceneDesc::shading_normals`).
+    shading_normals: Vec<Option<ShadingNormalDesc>>,
     textures: Vec<TextureDesc>,
     /// Texture names per namespace (pbrt-v4 keeps float and spectrum names apart).
     named_textures: HashMap<(TextureType, String), TextureId>,
@@ -241,6 +243,7 @@ impl Parser {
             filter: None,
             integrator: None,
             materials: Vec::new(),
+            shading_normals: Vec::new(),
             textures: Vec::new(),
             named_textures: HashMap::new(),
             shapes: Vec::new(),
@@ -552,6 +555,8 @@ impl Parser {
                 diagonal_mm: 35.0,
                 iso: 100.0,
                 gbuffer: None,
+                max_component_value: f32::INFINITY,
+                white_balance: None,
                 loc: loc.clone(),
             }),
             sampler: self.sampler.unwrap_or_else(|| SamplerDesc {
@@ -573,6 +578,7 @@ impl Parser {
                 loc,
             }),
             materials: self.materials,
+            shading_normals: self.shading_normals,
             textures: self.textures,
             shapes: self.shapes,
             objects: self.objects,

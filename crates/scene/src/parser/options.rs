@@ -8,7 +8,10 @@
 //!   `"realistic"`: `string lensfile` (required, relative to the scene file),
 //!   `float aperturediameter` 1.0 mm, `float focusdistance` 10.0 m.
 //! - `Film "rgb"`: `integer xresolution` 1280, `yresolution` 720,
-//!   `string filename` "pbrt.exr", `float diagonal` 35 mm, `float iso` 100.
+//!   `string filename` "pbrt.exr", `float diagonal` 35 mm, `float iso` 100,
+//!   `float maxcomponentvalue` (infinite), `string sensor` "cie1931" (camera sensors
+//!   are read as it, with a warning), `float whitebalance` 0 (none; 6500 K for a
+//!   camera sensor).
 //! - `Sampler`: `integer pixelsamples` 16, `integer seed` 0; `"stratified"` uses
 //!   `xsamples` × `ysamples` (4 × 4).
 //! - `PixelFilter`: `float xradius`/`yradius`; box 0.5, gaussian 1.5 (`sigma` 0.5),
@@ -27,6 +30,12 @@ impl Parser {
         let ps = self.param_list()?;
         self.require_options("Camera", loc)?;
         let camera_from_world = self.gs.ctm;
+        if !camera_from_world.is_invertible() {
+            return Err(SceneError::at(
+                loc,
+                "Camera: the current transform is singular (the camera needs its inverse)",
+            ));
+        }
         self.named_coord_systems
             .insert("camera".into(), camera_from_world.inverse());
         let kind = match name.as_str() {
@@ -155,15 +164,16 @@ impl Parser {
             diagonal_mm: ps.finite_float("diagonal", 35.0)?,
             iso: ps.finite_float("iso", 100.0)?,
             gbuffer,
+            max_component_value: film_max_component(&ps)?,
+            white_balance: None,
             loc: loc.clone(),
         };
-        let sensor_is_default = matches!(ps.strings("sensor")?, Some(([s], _)) if s == "cie1931");
-        let white_balance_off = matches!(ps.floats("whitebalance")?, Some(([w], _)) if *w == 0.0);
+        let film = FilmDesc {
+            white_balance: self.film_sensor(&ps)?,
+            ..film
+        };
         for (key, skip) in [
-            ("sensor", sensor_is_default),
-            ("whitebalance", white_balance_off),
             ("savefp16", false),
-            ("maxcomponentvalue", false),
             ("exposuretime", false),
             ("cropwindow", false),
             ("pixelbounds", false),
@@ -181,6 +191,50 @@ impl Parser {
         self.report_unused(&ps, &format!("Film \"{name}\""));
         self.film = Some(film);
         Ok(())
+    }
+
+    /// `sensor` and `whitebalance`. radiant renders RGB, so every sensor records
+    /// through the CIE 1931 observer (pbrt-v4's default `cie1931`); a named camera
+    /// sensor is read as that with a warning, and, as pbrt-v4 does for camera sensors,
+    /// white-balanced to 6500 K unless `whitebalance` says otherwise. Returns the white
+    /// balance temperature.
+    fn film_sensor(&mut self, ps: &ParamSet) -> Result<Option<f32>, SceneError> {
+        let mut camera_sensor = false;
+        if let Some((names, at)) = ps.strings("sensor")? {
+            let [name] = names else {
+                return Err(SceneError::at(at, "\"string sensor\" needs one value"));
+            };
+            let at = at.clone();
+            if name != "cie1931" {
+                camera_sensor = true;
+                let message = if CAMERA_SENSORS.contains(&name.as_str()) {
+                    format!(
+                        "Film: sensor \"{name}\" is rendered through the CIE 1931 observer (radiant renders RGB, not the camera's spectral response)"
+                    )
+                } else {
+                    format!(
+                        "Film: unknown sensor \"{name}\" (pbrt-v4 knows cie1931 and {}); rendered through the CIE 1931 observer",
+                        CAMERA_SENSORS.join(", ")
+                    )
+                };
+                self.warn(&at, message);
+            }
+        }
+        let t = ps.finite_float("whitebalance", 0.0)?;
+        if t < 0.0 {
+            let at = ps.lookup("whitebalance").expect("present").loc.clone();
+            return Err(SceneError::at(
+                &at,
+                "\"whitebalance\" must be positive (K) or 0 for none",
+            ));
+        }
+        Ok(if t > 0.0 {
+            Some(t)
+        } else if camera_sensor {
+            Some(6500.0)
+        } else {
+            None
+        })
     }
 
     pub(super) fn sampler(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
@@ -350,5 +404,43 @@ fn screen_window(ps: &ParamSet) -> Result<Option<[f32; 4]>, SceneError> {
             at,
             "frameaspectratio must be one positive number",
         )),
+    }
+}
+
+/// The camera sensors whose spectral responses pbrt-v4 ships.
+const CAMERA_SENSORS: [&str; 17] = [
+    "canon_eos_100d",
+    "canon_eos_1dx_mkii",
+    "canon_eos_200d",
+    "canon_eos_200d_mkii",
+    "canon_eos_5d",
+    "canon_eos_5d_mkii",
+    "canon_eos_5d_mkiii",
+    "canon_eos_5d_mkiv",
+    "canon_eos_5ds",
+    "canon_eos_m",
+    "hasselblad_l1d_20c",
+    "nikon_d810",
+    "nikon_d850",
+    "sony_a6400",
+    "sony_a7m3",
+    "sony_a7rm3",
+    "sony_a9",
+];
+
+/// `maxcomponentvalue` (default infinite), which must be positive.
+fn film_max_component(ps: &ParamSet) -> Result<f32, SceneError> {
+    let Some(p) = ps.lookup("maxcomponentvalue") else {
+        return Ok(f32::INFINITY);
+    };
+    let at = p.loc.clone();
+    let v = ps.float("maxcomponentvalue", f32::INFINITY)?;
+    if v > 0.0 && !v.is_nan() {
+        Ok(v)
+    } else {
+        Err(SceneError::at(
+            &at,
+            "\"maxcomponentvalue\" must be positive",
+        ))
     }
 }

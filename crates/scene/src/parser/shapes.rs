@@ -13,7 +13,8 @@
 //! - `"disk"`: `height` 0, `radius` 1, `innerradius` 0, `phimax` 360.
 //!
 //! Each shape takes the CTM as its render-from-object transform, the current material,
-//! `ReverseOrientation` and the current area light.
+//! `ReverseOrientation` and the current area light; `alpha` (float or float texture,
+//! default 1) makes it a cut-out.
 
 use std::path::Path;
 
@@ -27,6 +28,7 @@ use crate::mesh::{
     MeshData, first_non_finite2, first_non_finite3, first_out_of_range, repair_normals,
 };
 use crate::params::{ParamSet, ParamValue};
+use crate::texture::{FloatParam, TexturedParam};
 use crate::{obj, ply, subdiv};
 
 /// pbrt-v4 shapes radiant does not render.
@@ -45,13 +47,10 @@ impl Parser {
         let ps = with_defaults(self.param_list()?, &self.gs.defaults.shape);
         self.require_world("Shape", loc)?;
         let owner = format!("Shape \"{name}\"");
-        if let Some(p) = ps.lookup("alpha") {
-            let at = p.loc.clone();
-            self.warn(
-                &at,
-                format!("{owner}: alpha cut-outs are not supported; the shape is opaque"),
-            );
-        }
+        let alpha = match self.float_texture_param(&ps, "alpha", 1.0)? {
+            TexturedParam::Constant(a) if a >= 1.0 => None,
+            a => Some(a),
+        };
         ps.lookup("emissionfilename");
         let geometries = match name.as_str() {
             "trianglemesh" => vec![self.triangle_mesh(&ps, loc, &owner)?],
@@ -68,11 +67,11 @@ impl Parser {
             _ => return Err(SceneError::at(loc, format!("unknown shape \"{name}\""))),
         };
         self.report_unused(&ps, &owner);
-        self.add_shapes(geometries, loc);
+        self.add_shapes(geometries, alpha, loc);
         Ok(())
     }
 
-    fn add_shapes(&mut self, geometries: Vec<Geometry>, loc: &FileLoc) {
+    fn add_shapes(&mut self, geometries: Vec<Geometry>, alpha: Option<FloatParam>, loc: &FileLoc) {
         let render_from_object = self.gs.ctm;
         let material = self.current_material();
         let area_light = match (self.gs.area_light.clone(), self.object.is_some()) {
@@ -118,6 +117,7 @@ impl Parser {
             reverse_orientation: self.gs.reverse_orientation,
             material,
             area_light: area_light.clone(),
+            alpha,
             loc: loc.clone(),
         });
         match &mut self.object {

@@ -48,6 +48,14 @@ impl Parser {
         };
         let owner = format!("Texture \"{name}\" (\"{class}\")");
         let kind = self.texture_kind(ty, &class, &ps, loc, &owner)?;
+        if !self.gs.ctm.is_invertible() && maps_through_the_transform(&kind) {
+            return Err(SceneError::at(
+                loc,
+                format!(
+                    "{owner}: the current transform is singular, and this mapping needs its inverse"
+                ),
+            ));
+        }
         self.report_unused(&ps, &owner);
         let id = self.textures.len() as TextureId;
         match self.named_textures.entry((ty, name.clone())) {
@@ -489,5 +497,26 @@ fn parse_encoding(s: &str) -> Option<ColorEncoding> {
             let g: f32 = s.strip_prefix("gamma")?.trim().parse().ok()?;
             (g.is_finite() && g > 0.0).then_some(ColorEncoding::Gamma(g))
         }
+    }
+}
+
+/// Whether a texture's mapping reads the point through the inverse of the transform
+/// it was defined under (solid textures and the non-uv 2D mappings).
+fn maps_through_the_transform(kind: &TextureKind) -> bool {
+    let two_d = |m: &Mapping2D| !matches!(m, Mapping2D::Uv { .. });
+    match kind {
+        TextureKind::Checkerboard3D { .. }
+        | TextureKind::Fbm { .. }
+        | TextureKind::Wrinkled { .. }
+        | TextureKind::Windy { .. }
+        | TextureKind::Marble { .. } => true,
+        TextureKind::Checkerboard2D { mapping, .. }
+        | TextureKind::Bilerp { mapping, .. }
+        | TextureKind::Dots { mapping, .. }
+        | TextureKind::ImageMap { mapping, .. } => two_d(mapping),
+        TextureKind::Constant(_)
+        | TextureKind::Scale { .. }
+        | TextureKind::Mix { .. }
+        | TextureKind::DirectionMix { .. } => false,
     }
 }

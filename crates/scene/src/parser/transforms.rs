@@ -33,8 +33,17 @@ impl Parser {
         let t = match name {
             "Identity" => return self.set_ctm(Transform::IDENTITY),
             "Translate" => Transform::translate(vec3(&self.numbers(3, name)?)),
-            "Scale" => Transform::scale(vec3(&self.numbers(3, name)?))
-                .ok_or_else(|| singular("a zero scale factor makes the transform singular"))?,
+            "Scale" => {
+                let s = vec3(&self.numbers(3, name)?);
+                match Transform::scale(s) {
+                    Some(t) => t,
+                    None if s.is_finite() => {
+                        self.warn_singular(name, loc);
+                        Transform::from_matrix_or_singular(Mat4::from_scale(s))
+                    }
+                    None => return Err(singular("the scale factors must be finite")),
+                }
+            }
             "Rotate" => {
                 let v = self.numbers(4, name)?;
                 Transform::rotate(v[0], vec3(&v[1..]))
@@ -50,8 +59,17 @@ impl Parser {
                 let v = self.numbers(16, name)?;
                 let mut cols = [0.0f32; 16];
                 cols.copy_from_slice(&v);
-                let t = Transform::from_matrix(Mat4::from_cols_array(&cols))
-                    .ok_or_else(|| singular("the matrix is singular"))?;
+                let m = Mat4::from_cols_array(&cols);
+                if !m.is_finite() {
+                    return Err(singular("the matrix must be finite"));
+                }
+                let t = match Transform::from_matrix(m) {
+                    Some(t) => t,
+                    None => {
+                        self.warn_singular(name, loc);
+                        Transform::from_matrix_or_singular(m)
+                    }
+                };
                 if name == "Transform" {
                     return self.set_ctm(t);
                 }
@@ -93,6 +111,15 @@ impl Parser {
             self.gs.ctm = self.gs.ctm.compose(&t);
         }
         Ok(())
+    }
+
+    /// pbrt-v4 accepts singular transforms: shapes under them collapse and contribute
+    /// nothing; only a camera or texture that needs the inverse refuses them.
+    fn warn_singular(&mut self, name: &str, loc: &FileLoc) {
+        self.warn(
+            loc,
+            format!("{name}: the transform is singular; accepted as pbrt-v4 does (quadrics and object instances under it are left out, meshes are flattened)"),
+        );
     }
 
     fn set_ctm(&mut self, t: Transform) -> Result<(), SceneError> {
