@@ -36,9 +36,14 @@ fn stats(img: &Image, channel: usize) -> (f64, f64) {
 }
 
 /// Every pixel of the furnace converges to Le / (1 - albedo) = 2. All pixels share one
-/// distribution, so the spread between pixels measures the per-pixel noise: each pixel
-/// must lie within 5 of those standard deviations of 2, and the image mean within 4
-/// standard errors.
+/// distribution, so the spread between pixels measures the per-pixel noise: the image
+/// mean must lie within 4 standard errors of 2. Pixels are not normally distributed: a
+/// path that survives Russian roulette (from the fifth vertex on) goes on with a weight
+/// near 1, so a pixel's 16 paths have a long right tail (measured: 1.4 % of 4096 pixels
+/// beyond 3 standard deviations, against 0.27 % for a normal distribution, the largest
+/// 8 standard deviations out). So at most 3 % may lie beyond 3 standard deviations, and
+/// every pixel holds what every sample must — at least the emission seen first, 1 —
+/// and lies within 16 standard deviations.
 #[test]
 fn white_furnace_is_two_everywhere() {
     let img = render(&furnace(), 16, 2);
@@ -49,12 +54,17 @@ fn white_furnace_is_two_everywhere() {
             (mean - 2.0).abs() < 4.0 * se + 1e-6,
             "channel {c}: mean {mean}, se {se}"
         );
+        let mut beyond_3 = 0usize;
         for p in &img.pixels {
-            assert!(
-                (p[c] as f64 - 2.0).abs() < 5.0 * sd + 1e-6,
-                "pixel {p:?}, sd {sd}"
-            );
+            let d = (p[c] as f64 - 2.0).abs();
+            assert!(p[c] >= 1.0 && d < 16.0 * sd, "pixel {p:?}, sd {sd}");
+            beyond_3 += (d > 3.0 * sd) as usize;
         }
+        assert!(
+            beyond_3 * 100 <= 3 * img.pixels.len(),
+            "channel {c}: {beyond_3} of {} pixels beyond 3 sd",
+            img.pixels.len()
+        );
     }
 }
 
