@@ -361,6 +361,19 @@ fn light_bounds(light: &Light, scene: SceneSphere) -> Option<LightBounds> {
             },
             0.0,
         )),
+        // Bounded as an isotropic point light, as pbrt-v4 does.
+        Light::Goniometric(g) => Some(point(g.position, Cone::EVERYWHERE, PI / 2.0)),
+        Light::Projection(pr) => {
+            let (axis, cos_width) = pr.cone();
+            Some(point(
+                pr.position,
+                Cone {
+                    axis,
+                    theta: cos_width.clamp(-1.0, 1.0).acos(),
+                },
+                0.0,
+            ))
+        }
         Light::Distant { .. } | Light::Infinite { .. } => None,
         Light::Area(area) => {
             let (bounds, normals) = match &area.shape {
