@@ -397,3 +397,47 @@ fn irradiance_over_a_receiving_sphere_is_power_over_its_area() {
     let _ = PI;
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Light images that cannot be used: each a `file:line:column` error at the light's
+/// `filename` (or the light, when it names none), without a panic.
+#[test]
+fn malformed_light_images_are_located_errors() {
+    let corpus = |name: &str| radiant_testkit::repo_path("tests/scenes/malformed/world").join(name);
+    for (scene, line, column, words) in [
+        (
+            "missing_goniometric_image.pbrt",
+            3,
+            29,
+            &["cannot read goniometric light image", "no-such-diagram.exr"][..],
+        ),
+        (
+            "unreadable_projection_image.pbrt",
+            4,
+            3,
+            &["cannot read projection light image", "unreadable.pfm"][..],
+        ),
+        (
+            "nonsquare_goniometric.pbrt",
+            2,
+            27,
+            &["nonsquare-sky.pfm", "4x2", "square"][..],
+        ),
+        (
+            "projection_without_image.pbrt",
+            3,
+            1,
+            &["\"projection\" needs a \"filename\""][..],
+        ),
+    ] {
+        let path = corpus(scene);
+        let message = match radiant_scene::parse_file(&path) {
+            Err(e) => e.to_string(),
+            Ok(desc) => World::build(&desc).map(|_| ()).unwrap_err().to_string(),
+        };
+        let expected = format!("{}:{line}:{column}: error:", path.display());
+        assert!(message.starts_with(&expected), "{scene}: {message}");
+        for w in words {
+            assert!(message.contains(w), "{scene}: lacks \"{w}\": {message}");
+        }
+    }
+}
