@@ -15,7 +15,6 @@ use std::sync::Arc;
 
 use glam::{Mat3, Vec2, Vec3};
 use radiant_image::Image;
-use radiant_math::PI;
 use radiant_math::color::Rgb;
 use radiant_math::hash::Pcg32;
 use radiant_render::light::{
@@ -198,11 +197,8 @@ fn projection_light_is_dark_outside_its_image_and_behind() {
     assert!(p.intensity(-axis).is_black());
     // Wider than the image's corners: no light.
     let side = axis.any_orthonormal_vector();
-    let outside =
-        (axis * cos_width + side * 1.05 * (1.0 - cos_width * cos_width).sqrt()).normalize();
     let beyond = (axis * (cos_width * 0.9) + side).normalize();
     assert!(p.intensity(beyond).is_black());
-    let _ = outside;
     // sample_li: intensity over distance squared, towards the light.
     let at = p.position + axis * 3.0;
     let s = Light::Projection(Arc::new(p.clone()))
@@ -394,7 +390,6 @@ fn irradiance_over_a_receiving_sphere_is_power_over_its_area() {
             "mean irradiance {mean} vs Φ / 4πd² = {want}"
         );
     }
-    let _ = PI;
     std::fs::remove_dir_all(&dir).ok();
 }
 

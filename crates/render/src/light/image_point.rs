@@ -160,13 +160,12 @@ impl ProjectionLight {
         let ys: Vec<f64> = (0..=height)
             .map(|j| (1.0 - 2.0 * j as f64 / height as f64) * half_y as f64)
             .collect();
-        let mut out = Vec::with_capacity(width * height);
-        for j in 0..height {
-            for i in 0..width {
-                out.push(rect_solid_angle(xs[i], xs[i + 1], ys[j + 1], ys[j]));
-            }
-        }
-        out
+        ys.windows(2)
+            .flat_map(|y| {
+                xs.windows(2)
+                    .map(move |x| rect_solid_angle(x[0], x[1], y[1], y[0]))
+            })
+            .collect()
     }
 
     /// The image square point (u right, v down from the top) that the light-frame
