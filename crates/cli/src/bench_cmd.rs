@@ -66,6 +66,22 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             "{seconds:.2} s wall on {} threads",
             rayon::current_num_threads()
         );
+        println!("== render bitterli/teapot at its resolution, 64 spp, path tracer");
+        match teapot_scene() {
+            Some(path) => match radiant::scene::parse_file(&path) {
+                Ok(desc) => {
+                    let (seconds, _) = render_benchmark(&desc, 64);
+                    println!(
+                        "{seconds:.2} s wall on {} threads",
+                        rayon::current_num_threads()
+                    );
+                }
+                Err(e) => println!("skipped: {e}"),
+            },
+            None => println!(
+                "skipped: bitterli/teapot not found (set RADIANT_SHARED to the shared data folder)"
+            ),
+        }
         println!("== environment light sampling, sky with a small sun");
         println!(
             "{}",
@@ -266,6 +282,24 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
             .join(", ")
     );
     Ok(())
+}
+
+/// `data/scenes/bitterli/teapot/scene-v4.pbrt` under the shared data folder:
+/// `$RADIANT_SHARED`, else `../shared` beside the working folder or beside the
+/// repository the binary was built from.
+fn teapot_scene() -> Option<std::path::PathBuf> {
+    const REL: &str = "data/scenes/bitterli/teapot/scene-v4.pbrt";
+    let repo = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    std::env::var_os("RADIANT_SHARED")
+        .map(std::path::PathBuf::from)
+        .into_iter()
+        .chain([
+            std::path::PathBuf::from("../shared"),
+            std::path::PathBuf::from("shared"),
+            repo.join("../shared"),
+        ])
+        .map(|root| root.join(REL))
+        .find(|p| p.exists())
 }
 
 #[cfg(test)]

@@ -392,6 +392,38 @@ pub enum LightDesc {
         image: Option<EnvironmentImage>,
         loc: FileLoc,
     },
+    /// Point light at the origin of `render_from_light` whose intensity per direction
+    /// is `intensity` (`I` × `scale`) times the average of the RGB channels of `image`,
+    /// a square equal-area octahedral image over the light's frame with its y and z
+    /// axes exchanged (pbrt-v4). Without an image, isotropic. With `power`, the
+    /// intensity is rescaled when the world is built (the power depends on the image).
+    Goniometric {
+        render_from_light: Transform,
+        intensity: Rgb,
+        power: Option<f32>,
+        image: Option<LightImage>,
+        loc: FileLoc,
+    },
+    /// Point light at the origin of `render_from_light` projecting `image` (times
+    /// `scale`) along its +z through a pinhole; `fov` (degrees) spans the image's
+    /// narrower side. `power` is applied when the world is built.
+    Projection {
+        render_from_light: Transform,
+        scale: Rgb,
+        fov: f32,
+        power: Option<f32>,
+        image: LightImage,
+        loc: FileLoc,
+    },
+}
+
+/// An image file a light names (`filename`), read when the world is built.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightImage {
+    /// The file, resolved against the scene's folder.
+    pub path: PathBuf,
+    /// Where the scene names the file (for errors about it).
+    pub at: FileLoc,
 }
 
 /// The picture of an image-based infinite light, as the scene names it: a square image

@@ -505,7 +505,11 @@ fn unsupported_things_warn_once_each_and_parse_on() {
         s.warnings
     );
     assert_eq!(s.shapes.len(), 1);
-    assert!(s.lights.is_empty());
+    // A goniometric light without an image is isotropic (with the warning of line 11).
+    assert!(matches!(
+        s.lights[..],
+        [LightDesc::Goniometric { image: None, .. }]
+    ));
 }
 
 #[test]

@@ -197,6 +197,8 @@ pub fn delta_light_irradiance<V: Visibility>(
                     | Light::Spot { .. }
                     | Light::Distant { .. }
                     | Light::Infinite { .. }
+                    | Light::Goniometric(_)
+                    | Light::Projection(_)
             )
         })
         .collect();

@@ -225,6 +225,24 @@ impl EnvironmentMap {
         })
     }
 
+    /// A direction by the plain density (render space, unit), with its solid-angle
+    /// density; `None` when the image is black there.
+    pub fn sample_direction(&self, u: Vec2) -> Option<(Vec3, f32)> {
+        let (st, _) = self.plain.sample(u);
+        let w = (self.render_from_light * square_to_sphere(st)).normalize();
+        let pdf = self.plain_pdf(w);
+        (pdf > 0.0).then_some((w, pdf))
+    }
+
+    /// Solid-angle density of `sample_direction` for the direction `w`.
+    pub fn plain_pdf(&self, w: Vec3) -> f32 {
+        let l = (self.light_from_render * w).normalize_or_zero();
+        if l == Vec3::ZERO {
+            return 0.0;
+        }
+        self.plain.pdf(sphere_to_square(l)) / SOLID_ANGLE_PER_AREA
+    }
+
     /// Flux through the scene's disk: mean radiance × 4π sr × π R².
     pub fn power(&self, scene: SceneSphere) -> Rgb {
         self.mean * (4.0 * PI * PI * scene.radius * scene.radius)

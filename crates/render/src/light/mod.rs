@@ -1,4 +1,5 @@
-//! Light sources. The set is closed (area, point, spot, distant, infinite), so it is
+//! Light sources. The set is closed (area, point, spot, distant, infinite,
+//! goniometric, projection), so it is
 //! one enum; each variant's sampling lives in its own file, and the choice among the
 //! lights is the [`LightSampler`]'s.
 //!
@@ -10,6 +11,7 @@
 
 mod area;
 mod environment;
+mod image_point;
 mod infinite;
 mod point;
 mod sampler;
@@ -19,6 +21,7 @@ use glam::{Vec2, Vec3};
 
 pub use area::{AreaLight, EmittingMesh, LightShape, parallelogram_of};
 pub use environment::{EnvironmentMap, EnvironmentPicture, rotation_of};
+pub use image_point::{GoniometricLight, ProjectionLight};
 pub use sampler::{
     LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, LightSampler, SampledLight, UnknownLightSampler,
 };
@@ -182,13 +185,21 @@ pub enum Light {
         radiance: Rgb,
         map: Option<std::sync::Arc<EnvironmentMap>>,
     },
+    /// Point light with intensity per direction from an equal-area octahedral image.
+    Goniometric(std::sync::Arc<GoniometricLight>),
+    /// Point light projecting an image through a pinhole.
+    Projection(std::sync::Arc<ProjectionLight>),
 }
 
 impl Light {
     pub fn is_delta(&self) -> bool {
         matches!(
             self,
-            Light::Point { .. } | Light::Spot { .. } | Light::Distant { .. }
+            Light::Point { .. }
+                | Light::Spot { .. }
+                | Light::Distant { .. }
+                | Light::Goniometric(_)
+                | Light::Projection(_)
         )
     }
 
@@ -208,6 +219,8 @@ impl Light {
             Light::Infinite { radiance, .. } => {
                 *radiance * (4.0 * PI * PI * scene.radius * scene.radius)
             }
+            Light::Goniometric(g) => g.power(),
+            Light::Projection(pr) => pr.power(),
         }
     }
 
@@ -253,6 +266,8 @@ impl Light {
             }),
             Light::Infinite { map: Some(m), .. } => m.sample_li(ctx, u, scene),
             Light::Infinite { radiance, .. } => infinite::sample_li(ctx, *radiance, u, scene),
+            Light::Goniometric(g) => g.sample_li(p),
+            Light::Projection(pr) => pr.sample_li(p),
         }
     }
 
@@ -309,6 +324,8 @@ impl Light {
             Light::Infinite { radiance, .. } => {
                 Some(infinite::emit_infinite(*radiance, u_pos, u_dir, scene))
             }
+            Light::Goniometric(g) => g.sample_le(u_dir),
+            Light::Projection(pr) => pr.sample_le(u_dir),
         }
     }
 }

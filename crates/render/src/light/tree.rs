@@ -361,6 +361,19 @@ fn light_bounds(light: &Light, scene: SceneSphere) -> Option<LightBounds> {
             },
             0.0,
         )),
+        // Bounded as an isotropic point light, as pbrt-v4 does.
+        Light::Goniometric(g) => Some(point(g.position, Cone::EVERYWHERE, PI / 2.0)),
+        Light::Projection(pr) => {
+            let (axis, cos_width) = pr.cone();
+            Some(point(
+                pr.position,
+                Cone {
+                    axis,
+                    theta: cos_width.clamp(-1.0, 1.0).acos(),
+                },
+                0.0,
+            ))
+        }
         Light::Distant { .. } | Light::Infinite { .. } => None,
         Light::Area(area) => {
             let (bounds, normals) = match &area.shape {
@@ -434,7 +447,7 @@ fn similarity_scale(xf: &radiant_math::Transform) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::AreaLight;
+    use crate::light::{AreaLight, EnvironmentMap, GoniometricLight, ProjectionLight};
     use radiant_math::color::Rgb;
     use radiant_math::hash::Pcg32;
 
@@ -482,6 +495,32 @@ mod tests {
             cos_falloff_start: 0.9,
             cos_total_width: 0.8,
         });
+        // Image lights: a projector aimed down-left (bounded by the cone of its image's
+        // corners) and a goniometric light.
+        let pixels: Vec<Rgb> = (0..6 * 4).map(|k| Rgb::splat(1.0 + k as f32)).collect();
+        lights.push(Light::Projection(std::sync::Arc::new(
+            ProjectionLight::new(
+                Vec3::new(0.5, 1.0, -1.0),
+                glam::Mat3::from_rotation_x(2.0) * glam::Mat3::from_rotation_y(0.4),
+                40.0,
+                6,
+                4,
+                std::sync::Arc::new(pixels.clone()),
+                Rgb::splat(3.0),
+            ),
+        )));
+        let grey: Vec<Rgb> = (0..16).map(|k| Rgb::splat(k as f32 * 0.3)).collect();
+        lights.push(Light::Goniometric(std::sync::Arc::new(
+            GoniometricLight::new(
+                Vec3::new(-1.0, -2.0, 0.5),
+                std::sync::Arc::new(EnvironmentMap::new(
+                    4,
+                    std::sync::Arc::new(grey),
+                    Rgb::WHITE,
+                    glam::Mat3::IDENTITY,
+                )),
+            ),
+        )));
         lights.push(Light::Infinite {
             radiance: Rgb::splat(0.01),
             map: None,
@@ -545,8 +584,12 @@ mod tests {
             let ctx = receiver(&mut rng);
             for (i, light) in lights.iter().enumerate() {
                 let Light::Area(area) = light else {
-                    // The spot lights only inside its cone.
-                    if !matches!(light, Light::Spot { .. }) {
+                    // Point-like lights (a spot or a projector only inside its cone)
+                    // and lights at infinity: wherever they shine on the receiver.
+                    if light
+                        .sample_li(&ctx, glam::Vec2::splat(0.5), SCENE)
+                        .is_some()
+                    {
                         assert!(tree.pmf(&ctx, i) > 0.0, "light {i}");
                     }
                     continue;

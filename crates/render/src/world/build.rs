@@ -12,16 +12,17 @@ use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
 use crate::light::{
-    AreaLight, EmittingMesh, EnvironmentMap, EnvironmentPicture, LIGHT_SAMPLER_NAMES,
-    LIGHT_SAMPLER_PARAM, Light, LightSampler, LightShape, SceneSphere, parallelogram_of,
-    rotation_of,
+    AreaLight, EmittingMesh, EnvironmentMap, EnvironmentPicture, GoniometricLight,
+    LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, Light, LightSampler, LightShape, ProjectionLight,
+    SceneSphere, parallelogram_of, rotation_of,
 };
 use crate::material::Material;
 use crate::texture::{TextureSet, concrete_material};
 use radiant_math::Transform;
+use radiant_math::color::Rgb;
 use radiant_scene::{
-    AreaLightDesc, EnvironmentImage, FileLoc, Geometry, LightDesc, MaterialDesc, SceneDesc,
-    SceneError, ShapeDesc, TexturedMaterialDesc, TexturedParam, Warning,
+    AreaLightDesc, EnvironmentImage, FileLoc, Geometry, LightDesc, LightImage, MaterialDesc,
+    SceneDesc, SceneError, ShapeDesc, TexturedMaterialDesc, TexturedParam, Warning,
 };
 
 /// Point lookups per axis over the (u, v) square for a textured material's mean.
@@ -235,7 +236,173 @@ fn light_from_desc(l: &LightDesc, warnings: &mut Vec<Warning>) -> Result<Light, 
                 ))),
             }
         }
+        LightDesc::Goniometric {
+            render_from_light,
+            intensity,
+            power,
+            image,
+            loc,
+        } => goniometric_light(
+            render_from_light,
+            *intensity,
+            *power,
+            image.as_ref(),
+            loc,
+            warnings,
+        )?,
+        LightDesc::Projection {
+            render_from_light,
+            scale,
+            fov,
+            power,
+            image,
+            loc,
+        } => projection_light(
+            render_from_light,
+            *scale,
+            *fov,
+            *power,
+            image,
+            loc,
+            warnings,
+        )?,
     })
+}
+
+/// A light image as read, each pixel finite and at least 0; errors located at the
+/// `filename` parameter and naming `what`.
+fn read_light_image(
+    image: &LightImage,
+    what: &str,
+) -> Result<(usize, usize, Vec<Rgb>), BuildError> {
+    let at = &image.at;
+    let path = &image.path;
+    let read = radiant_image::read_image(path)
+        .map_err(|err| SceneError::at(at, format!("cannot read {what} image: {err}")))?;
+    if let Some(k) = read.pixels.iter().position(|p| !p.is_finite()) {
+        return Err(SceneError::at(
+            at,
+            format!(
+                "{}: pixel ({}, {}) is not finite",
+                path.display(),
+                k % read.width,
+                k / read.width
+            ),
+        ));
+    }
+    let pixels = read.pixels.iter().map(|p| p.clamp_min(0.0)).collect();
+    Ok((read.width, read.height, pixels))
+}
+
+/// Factor that makes luminance power `have` equal to `target` (1 with a warning when
+/// the light emits nothing).
+fn power_factor(target: Option<f32>, have: f32, loc: &FileLoc, warnings: &mut Vec<Warning>) -> f32 {
+    match target {
+        Some(phi) if have > 0.0 => phi / have,
+        Some(_) => {
+            warnings.push(Warning {
+                loc: loc.clone(),
+                message: "light \"power\" ignored: the light emits nothing".into(),
+            });
+            1.0
+        }
+        None => 1.0,
+    }
+}
+
+fn goniometric_light(
+    render_from_light: &Transform,
+    intensity: Rgb,
+    power: Option<f32>,
+    image: Option<&LightImage>,
+    loc: &FileLoc,
+    warnings: &mut Vec<Warning>,
+) -> Result<Light, BuildError> {
+    let position = render_from_light.point(Vec3::ZERO);
+    let Some(image) = image else {
+        let k = power_factor(
+            power,
+            intensity.luminance() * 4.0 * radiant_math::PI,
+            loc,
+            warnings,
+        );
+        return Ok(Light::Point {
+            position,
+            intensity: intensity * k,
+        });
+    };
+    let (width, height, pixels) = read_light_image(image, "goniometric light")?;
+    if width != height {
+        return Err(SceneError::at(
+            &image.at,
+            format!(
+                "{}: goniometric image is {width}x{height}; it must be square, in the \
+                 equal-area octahedral layout",
+                image.path.display()
+            ),
+        ));
+    }
+    let (rotation, similar) = rotation_of(render_from_light);
+    if !similar {
+        warnings.push(Warning {
+            loc: loc.clone(),
+            message: "LightSource \"goniometric\": the transform is not a rotation and uniform scale; only its rotation orients the image".into(),
+        });
+    }
+    // The image's polar axis is the light's +y: exchange y and z.
+    let swap_yz = Mat3::from_cols(Vec3::X, Vec3::Z, Vec3::Y);
+    let grey: Vec<Rgb> = pixels
+        .iter()
+        .map(|p| Rgb::splat((p.r + p.g + p.b) / 3.0))
+        .collect();
+    let mean = grey.iter().map(|p| p.r as f64).sum::<f64>() / grey.len() as f64;
+    let k = power_factor(
+        power,
+        (4.0 * std::f64::consts::PI * mean) as f32 * intensity.luminance(),
+        loc,
+        warnings,
+    );
+    let map = EnvironmentMap::new(width, Arc::new(grey), intensity * k, rotation * swap_yz);
+    Ok(Light::Goniometric(Arc::new(GoniometricLight::new(
+        position,
+        Arc::new(map),
+    ))))
+}
+
+fn projection_light(
+    render_from_light: &Transform,
+    scale: Rgb,
+    fov: f32,
+    power: Option<f32>,
+    image: &LightImage,
+    loc: &FileLoc,
+    warnings: &mut Vec<Warning>,
+) -> Result<Light, BuildError> {
+    let (width, height, pixels) = read_light_image(image, "projection light")?;
+    let (rotation, similar) = rotation_of(render_from_light);
+    if !similar {
+        warnings.push(Warning {
+            loc: loc.clone(),
+            message: "LightSource \"projection\": the transform is not a rotation and uniform scale; only its rotation orients the image".into(),
+        });
+    }
+    let position = render_from_light.point(Vec3::ZERO);
+    let pixels = Arc::new(pixels);
+    let light = ProjectionLight::new(
+        position,
+        rotation,
+        fov,
+        width,
+        height,
+        pixels.clone(),
+        scale,
+    );
+    let k = power_factor(power, light.power().luminance(), loc, warnings);
+    Ok(Light::Projection(Arc::new(if k == 1.0 {
+        light
+    } else {
+        ProjectionLight::new(position, rotation, fov, width, height, pixels, scale * k)
+    })))
 }
 
 /// Reads the image of an infinite light: square (pbrt-v4's equal-area octahedral

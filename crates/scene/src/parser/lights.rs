@@ -14,6 +14,9 @@
 //! - `"distant"`: `L`, `from` (0,0,0), `to` (0,0,1), `scale`, `illuminance`.
 //! - `"infinite"`: `L` (constant) or `filename` (a square equal-area octahedral image:
 //!   EXR, PFM or PNG), `scale`, `illuminance`; `portal` is read and ignored.
+//! - `"goniometric"`: `I`, `scale`, `power`, `filename` (a square equal-area
+//!   octahedral image; its RGB channels are averaged).
+//! - `"projection"`: `filename`, `fov` 90°, `scale`, `power`.
 //! - `AreaLightSource "diffuse"`: `L`, `scale`, `twosided` (false), `power`.
 
 use glam::Vec3;
@@ -21,7 +24,7 @@ use glam::Vec3;
 use super::Parser;
 use super::spectrum_param::SpectrumUse;
 use super::state::{AreaLightState, with_defaults};
-use crate::desc::{EnvironmentImage, LightDesc};
+use crate::desc::{EnvironmentImage, LightDesc, LightImage};
 use crate::error::{FileLoc, SceneError};
 use crate::params::{ParamSet, ParamValue};
 use radiant_math::PI;
@@ -162,16 +165,68 @@ impl Parser {
                     self.infinite_light(&ps, l, e, &owner, loc)?
                 }
             }
-            "goniometric" | "projection" => {
-                ps.mark_all_used();
-                self.warn(loc, format!("{owner} is not supported; light skipped"));
-                return Ok(());
+            "goniometric" => {
+                let scale = self.light_scale(&ps, &owner)?;
+                let i = self.spectrum_or(&ps, "I", SpectrumUse::Illuminant, Rgb::WHITE, &owner)?
+                    * scale;
+                let power = Self::optional_positive(&ps, "power")?;
+                let image = self.light_image(&ps)?;
+                if image.is_none() {
+                    self.warn(
+                        loc,
+                        format!("{owner}: no \"filename\"; the light is isotropic"),
+                    );
+                }
+                LightDesc::Goniometric {
+                    render_from_light: ctm,
+                    intensity: i,
+                    power,
+                    image,
+                    loc: loc.clone(),
+                }
+            }
+            "projection" => {
+                let scale = self.light_scale(&ps, &owner)?;
+                let power = Self::optional_positive(&ps, "power")?;
+                let fov = ps.finite_float("fov", 90.0)?;
+                if !(fov > 0.0 && fov < 180.0) {
+                    let at = ps.lookup("fov").map_or(loc.clone(), |p| p.loc.clone());
+                    return Err(SceneError::at(
+                        &at,
+                        format!("{owner}: \"fov\" must lie between 0 and 180 degrees"),
+                    ));
+                }
+                let Some(image) = self.light_image(&ps)? else {
+                    return Err(SceneError::at(loc, format!("{owner} needs a \"filename\"")));
+                };
+                LightDesc::Projection {
+                    render_from_light: ctm,
+                    scale,
+                    fov,
+                    power,
+                    image,
+                    loc: loc.clone(),
+                }
             }
             _ => return Err(SceneError::at(loc, format!("unknown light \"{name}\""))),
         };
         self.report_unused(&ps, &owner);
         self.lights.push(light);
         Ok(())
+    }
+
+    /// The light's `"string filename"`, resolved against the scene's folder.
+    fn light_image(&mut self, ps: &ParamSet) -> Result<Option<LightImage>, SceneError> {
+        let Some((names, at)) = ps.strings("filename")? else {
+            return Ok(None);
+        };
+        let [written] = names else {
+            return Err(SceneError::at(at, "\"filename\" needs one value"));
+        };
+        Ok(Some(LightImage {
+            path: self.resolve_path(written),
+            at: at.clone(),
+        }))
     }
 
     /// `LightSource "infinite"`: constant `l`, or the image of `filename` times the

@@ -172,7 +172,9 @@ impl ProjectionMaps {
 /// means no map.
 fn resolution(light: &Light) -> (u32, u32) {
     match light {
-        Light::Point { .. } | Light::Spot { .. } => (1, DIR_RES),
+        Light::Point { .. } | Light::Spot { .. } | Light::Goniometric(_) | Light::Projection(_) => {
+            (1, DIR_RES)
+        }
         Light::Area(a) => match a.shape {
             LightShape::Triangle { .. }
             | LightShape::Parallelogram { .. }
