@@ -43,31 +43,7 @@ pub fn write_exr(
     let path = path.as_ref();
     image.validate(path)?;
 
-    let software = if meta.software.is_empty() {
-        concat!("radiant ", env!("CARGO_PKG_VERSION")).to_string()
-    } else {
-        meta.software.clone()
-    };
-    let mut layer_attributes = x::LayerAttributes::default();
-    // EXR text attributes are Latin-1; anything beyond it becomes '?'.
-    let latin1: String = software
-        .chars()
-        .map(|c| if (c as u32) < 256 { c } else { '?' })
-        .collect();
-    layer_attributes.software_name = Text::new_or_none(latin1);
-    if let Some(spp) = meta.samples_per_pixel {
-        // EXR has no unsigned int attribute; more than 2^31 samples per pixel would be absurd.
-        let spp = i32::try_from(spp).unwrap_or(i32::MAX);
-        layer_attributes
-            .other
-            .insert(Text::from(ATTR_SAMPLES_PER_PIXEL), AttributeValue::I32(spp));
-    }
-
-    let encoding = x::Encoding {
-        compression: x::Compression::ZIP16,
-        blocks: x::Blocks::ScanLines,
-        line_order: x::LineOrder::Increasing,
-    };
+    let (layer_attributes, encoding) = (layer_attributes(meta), ENCODING);
     let width = image.width;
     let pixels = &image.pixels;
     let channels = x::SpecificChannels::rgb(|pos: x::Vec2<usize>| {
@@ -81,25 +57,12 @@ pub fn write_exr(
         channels,
     );
     let mut exr_image = x::Image::from_layer(layer);
-    exr_image.attributes.chromaticities = Some(rec709_chromaticities());
-    if let Some(t) = meta.render_time_seconds {
-        exr_image
-            .attributes
-            .other
-            .insert(Text::from(ATTR_RENDER_TIME), AttributeValue::F32(t as f32));
-    }
+    image_attributes(&mut exr_image.attributes, meta);
     super::write_atomically(path, |file| {
         exr_image
             .write()
             .to_buffered(file)
-            .map_err(|error| match error {
-                // The operating system's reason (disk full, permission) as it stands.
-                ::exr::error::Error::Io(e) => ImageError::io(path, e),
-                error => ImageError::Exr {
-                    path: path.to_path_buf(),
-                    error,
-                },
-            })
+            .map_err(|error| write_error(path, error))
     })
 }
 
@@ -132,28 +95,7 @@ pub fn write_exr_channels(
             });
         }
     }
-    let software = if meta.software.is_empty() {
-        concat!("radiant ", env!("CARGO_PKG_VERSION")).to_string()
-    } else {
-        meta.software.clone()
-    };
-    let mut layer_attributes = x::LayerAttributes::default();
-    let latin1: String = software
-        .chars()
-        .map(|c| if (c as u32) < 256 { c } else { '?' })
-        .collect();
-    layer_attributes.software_name = Text::new_or_none(latin1);
-    if let Some(spp) = meta.samples_per_pixel {
-        let spp = i32::try_from(spp).unwrap_or(i32::MAX);
-        layer_attributes
-            .other
-            .insert(Text::from(ATTR_SAMPLES_PER_PIXEL), AttributeValue::I32(spp));
-    }
-    let encoding = x::Encoding {
-        compression: x::Compression::ZIP16,
-        blocks: x::Blocks::ScanLines,
-        line_order: x::LineOrder::Increasing,
-    };
+    let (layer_attributes, encoding) = (layer_attributes(meta), ENCODING);
     let mut channels: Vec<x::AnyChannel<x::FlatSamples>> = Vec::with_capacity(3 + extra.len());
     for (k, name) in ["R", "G", "B"].into_iter().enumerate() {
         let values = image.pixels.iter().map(|p| p.to_array()[k]).collect();
@@ -176,25 +118,66 @@ pub fn write_exr_channels(
         x::AnyChannels::sort(channels.into()),
     );
     let mut exr_image = x::Image::from_layer(layer);
-    exr_image.attributes.chromaticities = Some(rec709_chromaticities());
-    if let Some(t) = meta.render_time_seconds {
-        exr_image
-            .attributes
-            .other
-            .insert(Text::from(ATTR_RENDER_TIME), AttributeValue::F32(t as f32));
-    }
+    image_attributes(&mut exr_image.attributes, meta);
     super::write_atomically(path, |file| {
         exr_image
             .write()
             .to_buffered(file)
-            .map_err(|error| match error {
-                ::exr::error::Error::Io(e) => ImageError::io(path, e),
-                error => ImageError::Exr {
-                    path: path.to_path_buf(),
-                    error,
-                },
-            })
+            .map_err(|error| write_error(path, error))
     })
+}
+
+/// Scan lines of 16 rows, ZIP-compressed, top row first.
+const ENCODING: x::Encoding = x::Encoding {
+    compression: x::Compression::ZIP16,
+    blocks: x::Blocks::ScanLines,
+    line_order: x::LineOrder::Increasing,
+};
+
+/// The layer's software name and sample count.
+fn layer_attributes(meta: &ImageMeta) -> x::LayerAttributes {
+    let software = if meta.software.is_empty() {
+        concat!("radiant ", env!("CARGO_PKG_VERSION")).to_string()
+    } else {
+        meta.software.clone()
+    };
+    let mut layer_attributes = x::LayerAttributes::default();
+    // EXR text attributes are Latin-1; anything beyond it becomes '?'.
+    let latin1: String = software
+        .chars()
+        .map(|c| if (c as u32) < 256 { c } else { '?' })
+        .collect();
+    layer_attributes.software_name = Text::new_or_none(latin1);
+    if let Some(spp) = meta.samples_per_pixel {
+        // EXR has no unsigned int attribute; more than 2^31 samples per pixel would be absurd.
+        let spp = i32::try_from(spp).unwrap_or(i32::MAX);
+        layer_attributes
+            .other
+            .insert(Text::from(ATTR_SAMPLES_PER_PIXEL), AttributeValue::I32(spp));
+    }
+    layer_attributes
+}
+
+/// The image's chromaticities (Rec. 709 primaries) and render time.
+fn image_attributes(attributes: &mut x::ImageAttributes, meta: &ImageMeta) {
+    attributes.chromaticities = Some(rec709_chromaticities());
+    if let Some(t) = meta.render_time_seconds {
+        attributes
+            .other
+            .insert(Text::from(ATTR_RENDER_TIME), AttributeValue::F32(t as f32));
+    }
+}
+
+/// The operating system's reason (disk full, permission) as it stands, else the
+/// encoder's.
+fn write_error(path: &Path, error: ::exr::error::Error) -> ImageError {
+    match error {
+        ::exr::error::Error::Io(e) => ImageError::io(path, e),
+        error => ImageError::Exr {
+            path: path.to_path_buf(),
+            error,
+        },
+    }
 }
 
 /// Reads the first layer of an EXR that has R, G and B channels (bare or as `<layer>.R`,

@@ -5,12 +5,12 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use radiant::Session;
 use radiant::image::Image;
 use radiant::render::geometry::Ray;
 use radiant::render::world::World;
-use radiant::render::{Overrides, Progress};
-use radiant::scene::{SceneDesc, parse_file, parse_str};
+use radiant::scene::{SceneDesc, parse_str};
+
+mod common;
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("radiant-alpha-{}-{name}", std::process::id()));
@@ -23,16 +23,7 @@ fn parse_in(text: &str, dir: &Path) -> SceneDesc {
 }
 
 fn render(path: &Path, spp: u32) -> Image {
-    let desc = parse_file(path).unwrap_or_else(|e| panic!("{e}"));
-    let session = Session::new(
-        &desc,
-        &Overrides {
-            spp: Some(spp),
-            ..Default::default()
-        },
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    session.render(&Progress::default()).film.image()
+    common::render_file(path, spp)
 }
 
 /// A floor lit from above by a small area light, seen from above and at a slant;

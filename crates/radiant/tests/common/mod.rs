@@ -14,6 +14,18 @@ pub fn render(desc: &SceneDesc, overrides: &Overrides) -> Image {
     session.render(&Progress::default()).film.image()
 }
 
+/// Renders the scene file at `path` with `spp` samples per pixel.
+pub fn render_file(path: &std::path::Path, spp: u32) -> Image {
+    let desc = radiant::scene::parse_file(path).unwrap_or_else(|e| panic!("{e}"));
+    render(
+        &desc,
+        &Overrides {
+            spp: Some(spp),
+            ..Default::default()
+        },
+    )
+}
+
 /// Reads `key value` lines of a reference's `.noise.txt`.
 pub fn noise_figure(rel: &str, key: &str) -> f64 {
     let text = std::fs::read_to_string(shared(rel)).expect("noise file");
