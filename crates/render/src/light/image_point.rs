@@ -18,7 +18,6 @@ use std::sync::Arc;
 use glam::{Mat3, Vec2, Vec3};
 
 use super::{EnvironmentMap, LightLeSample, LightLiSample};
-use crate::geometry::Ray;
 use radiant_math::color::Rgb;
 use radiant_math::{Distribution2D, PI};
 
@@ -56,14 +55,7 @@ impl GoniometricLight {
     pub fn sample_le(&self, u_dir: Vec2) -> Option<LightLeSample> {
         let (d, pdf_dir) = self.map.sample_direction(u_dir)?;
         let le = self.intensity(d);
-        (!le.is_black()).then(|| LightLeSample {
-            ray: Ray::new(self.position, d),
-            n: Vec3::ZERO,
-            pdf_pos: 1.0,
-            pdf_dir,
-            le,
-            power: le / pdf_dir,
-        })
+        (!le.is_black()).then(|| LightLeSample::from_point(self.position, d, le, pdf_dir))
     }
 
     /// Solid-angle density of `sample_le`'s direction `w` (render space).
@@ -233,14 +225,8 @@ impl ProjectionLight {
         let d = (self.render_from_light * self.direction_of(st)).normalize();
         let le = self.intensity(d);
         let pdf_dir = self.pdf_dir(d);
-        (!le.is_black() && pdf_dir > 0.0).then(|| LightLeSample {
-            ray: Ray::new(self.position, d),
-            n: Vec3::ZERO,
-            pdf_pos: 1.0,
-            pdf_dir,
-            le,
-            power: le / pdf_dir,
-        })
+        (!le.is_black() && pdf_dir > 0.0)
+            .then(|| LightLeSample::from_point(self.position, d, le, pdf_dir))
     }
 
     pub fn size(&self) -> (usize, usize) {

@@ -137,6 +137,21 @@ pub struct LightLeSample {
     pub power: Rgb,
 }
 
+impl LightLeSample {
+    /// A ray leaving a point light's certain position along `d`, drawn with density
+    /// `pdf_dir`, carrying the intensity `le`.
+    pub fn from_point(position: Vec3, d: Vec3, le: Rgb, pdf_dir: f32) -> LightLeSample {
+        LightLeSample {
+            ray: Ray::new(position, d),
+            n: Vec3::ZERO,
+            pdf_pos: 1.0,
+            pdf_dir,
+            le,
+            power: le / pdf_dir,
+        }
+    }
+}
+
 /// Centre and radius of a sphere bounding the scene (for lights at infinity).
 #[derive(Clone, Copy, Debug)]
 pub struct SceneSphere {

@@ -42,14 +42,12 @@ pub(super) fn spot_falloff(
 }
 
 pub(super) fn emit_point(position: Vec3, intensity: Rgb, u: Vec2) -> LightLeSample {
-    LightLeSample {
-        ray: Ray::new(position, sampling::uniform_sphere(u)),
-        n: Vec3::ZERO,
-        pdf_pos: 1.0,
-        pdf_dir: sampling::UNIFORM_SPHERE_PDF,
-        le: intensity,
-        power: intensity / sampling::UNIFORM_SPHERE_PDF,
-    }
+    LightLeSample::from_point(
+        position,
+        sampling::uniform_sphere(u),
+        intensity,
+        sampling::UNIFORM_SPHERE_PDF,
+    )
 }
 
 /// Directions uniform in the spot's whole cone; the falloff goes into the power.

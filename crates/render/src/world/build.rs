@@ -275,10 +275,28 @@ fn read_light_image(
     image: &LightImage,
     what: &str,
 ) -> Result<(usize, usize, Vec<Rgb>), BuildError> {
-    let at = &image.at;
-    let path = &image.path;
-    let read = radiant_image::read_image(path)
-        .map_err(|err| SceneError::at(at, format!("cannot read {what} image: {err}")))?;
+    let read = read_located(&image.path, &image.at, what)?;
+    let pixels = finite_pixels(&read, &image.path, &image.at)?;
+    Ok((read.width, read.height, pixels))
+}
+
+/// The image at `path`, a read error located at `at` and naming `what`.
+fn read_located(
+    path: &std::path::Path,
+    at: &FileLoc,
+    what: &str,
+) -> Result<radiant_image::Image, BuildError> {
+    radiant_image::read_image(path)
+        .map_err(|err| SceneError::at(at, format!("cannot read {what} image: {err}")).into())
+}
+
+/// The image's pixels with negative values clamped to 0; a non-finite pixel is an
+/// error located at `at`.
+fn finite_pixels(
+    read: &radiant_image::Image,
+    path: &std::path::Path,
+    at: &FileLoc,
+) -> Result<Vec<Rgb>, BuildError> {
     if let Some(k) = read.pixels.iter().position(|p| !p.is_finite()) {
         return Err(SceneError::at(
             at,
@@ -288,10 +306,10 @@ fn read_light_image(
                 k % read.width,
                 k / read.width
             ),
-        ));
+        )
+        .into());
     }
-    let pixels = read.pixels.iter().map(|p| p.clamp_min(0.0)).collect();
-    Ok((read.width, read.height, pixels))
+    Ok(read.pixels.iter().map(|p| p.clamp_min(0.0)).collect())
 }
 
 /// Factor that makes luminance power `have` equal to `target` (1 with a warning when
@@ -411,8 +429,7 @@ fn projection_light(
 fn read_environment_image(image: &EnvironmentImage) -> Result<EnvironmentPicture, BuildError> {
     let at = &image.at;
     let path = &image.path;
-    let read = radiant_image::read_image(path)
-        .map_err(|err| SceneError::at(at, format!("cannot read environment image: {err}")))?;
+    let read = read_located(path, at, "environment")?;
     if read.width != read.height {
         return Err(SceneError::at(
             at,
@@ -426,20 +443,9 @@ fn read_environment_image(image: &EnvironmentImage) -> Result<EnvironmentPicture
             ),
         ));
     }
-    if let Some(k) = read.pixels.iter().position(|p| !p.is_finite()) {
-        return Err(SceneError::at(
-            at,
-            format!(
-                "{}: pixel ({}, {}) is not finite",
-                path.display(),
-                k % read.width,
-                k / read.width
-            ),
-        ));
-    }
     Ok(EnvironmentPicture {
         size: read.width,
-        pixels: read.pixels.iter().map(|p| p.clamp_min(0.0)).collect(),
+        pixels: finite_pixels(&read, path, at)?,
     })
 }
 
