@@ -287,7 +287,7 @@ fn read_located(
     what: &str,
 ) -> Result<radiant_image::Image, BuildError> {
     radiant_image::read_image(path)
-        .map_err(|err| SceneError::at(at, format!("cannot read {what} image: {err}")).into())
+        .map_err(|err| SceneError::at(at, format!("cannot read {what} image: {err}")))
 }
 
 /// The image's pixels with negative values clamped to 0; a non-finite pixel is an
@@ -306,8 +306,7 @@ fn finite_pixels(
                 k % read.width,
                 k / read.width
             ),
-        )
-        .into());
+        ));
     }
     Ok(read.pixels.iter().map(|p| p.clamp_min(0.0)).collect())
 }
