@@ -38,7 +38,7 @@ use radiant::render::integrator::{PhotonMapIntegrator, SppmStats};
 use radiant::render::{Overrides, Progress, RenderOutput};
 use radiant::scene::builtin::{cornell_box, furnace};
 use radiant::scene::params::{ParamSet, ParamValue};
-use radiant::scene::{SamplerKind, SceneDesc};
+use radiant::scene::{DigitRandomization, SamplerKind, SceneDesc};
 use radiant_testkit::fixtures::{
     LIT_SPHERE_INTENSITY, LIT_SPHERE_RADIANCE, PixelFilter, SPHERE_ALBEDO, glowing_sphere,
     glowing_sphere_radiance, lit_sphere, with_camera, with_filter, with_integrator, with_iso,
@@ -54,6 +54,30 @@ const RES: u32 = 16;
 const Z: f64 = 4.5;
 
 const SAMPLERS: [SamplerKind; 2] = [SamplerKind::Sobol, SamplerKind::Independent];
+
+/// The path tracer also runs with every other sampler: Halton points under each digit
+/// randomisation and 16 × 16 jittered strata (its 256 samples, one per stratum) — an
+/// unbiased sampler must give the closed form within the pixels' noise.
+const PATH_SAMPLERS: [SamplerKind; 6] = [
+    SamplerKind::Sobol,
+    SamplerKind::Independent,
+    SamplerKind::Halton {
+        randomization: DigitRandomization::PermuteDigits,
+    },
+    SamplerKind::Halton {
+        randomization: DigitRandomization::Owen,
+    },
+    SamplerKind::Stratified {
+        x: 16,
+        y: 16,
+        jitter: true,
+    },
+    SamplerKind::Stratified {
+        x: 32,
+        y: 8,
+        jitter: true,
+    },
+];
 
 /// One analytic scene: its description and the radiance everywhere inside.
 struct Analytic {
@@ -171,7 +195,11 @@ struct Config {
 }
 
 fn configs() -> impl Iterator<Item = Config> {
-    SAMPLERS.into_iter().flat_map(|sampler| {
+    configs_of(&SAMPLERS)
+}
+
+fn configs_of(samplers: &'static [SamplerKind]) -> impl Iterator<Item = Config> {
+    samplers.iter().copied().flat_map(|sampler| {
         PixelFilter::ALL
             .into_iter()
             .map(move |filter| Config { sampler, filter })
@@ -343,9 +371,10 @@ fn render_both_isos(
 fn path_matrix() {
     let mut report = Report::default();
     for (k, scene) in analytic_scenes().iter().enumerate() {
-        for (j, config) in configs().enumerate() {
+        for (j, config) in configs_of(&PATH_SAMPLERS).enumerate() {
             let case = case_name(&PATH, scene, config);
-            let (_, out, high) = render_both_isos(scene, &PATH, config, (4 * k + j) as u64);
+            let seed = (2 * PATH_SAMPLERS.len() * k + j) as u64;
+            let (_, out, high) = render_both_isos(scene, &PATH, config, seed);
             let img = out.film.image();
             let expect = scene.radiance.to_array().map(|l| l as f64);
             check_independent_pixels(&mut report, &case, &img, expect, [0.0; 3]);
@@ -716,14 +745,7 @@ fn images_are_identical_at_one_and_two_threads() {
         let method = with_spp(method, 4);
         let desc = case_desc(&box16, &method, config_zero(), 100.0, 3);
         let s = session(&desc);
-        let at = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            pool.install(|| s.render(&Progress::default())).film.image()
-        };
-        let (one, two) = (at(1), at(2));
+        let (one, two) = (render_on_threads(&s, 1), render_on_threads(&s, 2));
         let bits = |img: &Image| -> Vec<[u32; 3]> {
             img.pixels
                 .iter()
@@ -733,6 +755,26 @@ fn images_are_identical_at_one_and_two_threads() {
         assert!(one.mean() > 0.0, "{}", method.name);
         assert!(bits(&one) == bits(&two), "{}: images differ", method.name);
     }
+    for sampler in PATH_SAMPLERS {
+        let config = Config {
+            sampler,
+            ..config_zero()
+        };
+        let desc = case_desc(&box16, &with_spp(&PATH, 4), config, 100.0, 3);
+        let s = session(&desc);
+        assert!(
+            render_on_threads(&s, 1) == render_on_threads(&s, 2),
+            "path with {sampler:?}: images differ"
+        );
+    }
+}
+
+fn render_on_threads(s: &Session, threads: usize) -> Image {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| s.render(&Progress::default())).film.image()
 }
 
 /// The furnace emits and reflects only inwards: seen from outside (the scene has no

@@ -116,10 +116,30 @@ pub enum GBufferSpace {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SamplerKind {
-    /// Owen-scrambled Sobol (any low-discrepancy pbrt sampler maps here).
+    /// Owen-scrambled Sobol (pbrt-v4's `sobol`, `paddedsobol`, `zsobol` and `pmj02bn`
+    /// map here: each is a (0,2)-sequence in every dimension pair).
     Sobol,
     /// Independent uniform random numbers.
     Independent,
+    /// Per-pixel Halton points: dimension pair k in the prime bases of the 2k-th and
+    /// (2k+1)-th primes, each pixel's digits randomised independently.
+    Halton { randomization: DigitRandomization },
+    /// `x` × `y` jittered strata per pixel (pbrt-v4's `stratified`), each dimension's
+    /// strata visited in a per-pixel random order.
+    Stratified { x: u32, y: u32, jitter: bool },
+}
+
+/// How the digits of a radical inverse are randomised (pbrt-v4's `"randomization"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DigitRandomization {
+    /// The plain radical inverse: every pixel sees the same points.
+    None,
+    /// One random permutation per digit position (Faure 1992; pbrt's `permutedigits`).
+    PermuteDigits,
+    /// Nested scrambling: each digit's permutation depends on the digits before it
+    /// (Owen 1995, "Randomly permuted (t,m,s)-nets and (t,s)-sequences"); pbrt's
+    /// `owen` and `fastowen`.
+    Owen,
 }
 
 /// `Sampler`: kind, samples per pixel and seed.

@@ -7,8 +7,8 @@ use radiant_math::{PI, Vec2, Vec3};
 use radiant_scene::named_spectra::metal_spectrum;
 use radiant_scene::spectrum::blackbody_rgb;
 use radiant_scene::{
-    CameraKind, CoatDesc, ConductorDesc, FilterKind, Geometry, LightDesc, MaterialDesc,
-    SamplerKind, SceneDesc, TexturedMaterialDesc, TexturedParam, parse_str,
+    CameraKind, CoatDesc, ConductorDesc, DigitRandomization, FilterKind, Geometry, LightDesc,
+    MaterialDesc, SamplerKind, SceneDesc, TexturedMaterialDesc, TexturedParam, parse_str,
 };
 
 fn parse(text: &str) -> SceneDesc {
@@ -75,14 +75,55 @@ fn options_are_read_with_their_defaults() {
         (300, 720, 400.0)
     );
     assert_eq!(s.sampler.pixel_samples, 15);
+    assert_eq!(
+        s.sampler.kind,
+        SamplerKind::Stratified {
+            x: 3,
+            y: 5,
+            jitter: false
+        }
+    );
     assert_eq!(s.filter.radius, Vec2::new(2.0, 1.0));
     // The integrator's parameters are left for the integrator to use and report.
-    assert!(s.warnings.iter().all(|w| !w.message.contains("maxdepth")));
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+}
+
+#[test]
+fn samplers_read_their_randomization() {
+    let kind = |text: &str| parse(&format!("{text}\nWorldBegin\n")).sampler.kind;
+    let halton = |randomization| SamplerKind::Halton { randomization };
     assert_eq!(
-        s.warnings.len(),
-        1,
-        "stratified → Sobol note: {:?}",
-        s.warnings
+        kind("Sampler \"halton\""),
+        halton(DigitRandomization::PermuteDigits)
+    );
+    for (name, r) in [
+        ("none", DigitRandomization::None),
+        ("permutedigits", DigitRandomization::PermuteDigits),
+        ("fastowen", DigitRandomization::Owen),
+        ("owen", DigitRandomization::Owen),
+    ] {
+        let text = format!("Sampler \"halton\" \"string randomization\" \"{name}\"");
+        assert_eq!(kind(&text), halton(r), "{name}");
+    }
+    assert_eq!(
+        kind("Sampler \"stratified\""),
+        SamplerKind::Stratified {
+            x: 4,
+            y: 4,
+            jitter: true
+        }
+    );
+    let e = err("Sampler \"halton\" \"string randomization\" \"shuffle\"\nWorldBegin\n");
+    assert!(e.contains("t.pbrt:1:18") && e.contains("shuffle"), "{e}");
+    // Sobol points are always scrambled: asking for none is a warning at the parameter.
+    let s = parse("Sampler \"sobol\" \"string randomization\" \"none\"\nWorldBegin\n");
+    assert_eq!(s.sampler.kind, SamplerKind::Sobol);
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert_eq!(s.warnings[0].loc.column, 17, "{:?}", s.warnings);
+    assert!(
+        parse("Sampler \"zsobol\"\nWorldBegin\n").warnings[0]
+            .message
+            .contains("Owen-scrambled Sobol")
     );
 }
 
@@ -491,7 +532,7 @@ fn area_lights_scale_and_power() {
 #[test]
 fn unsupported_things_warn_once_each_and_parse_on() {
     let s = parse(
-        "Sampler \"halton\"\nPixelFilter \"mitchell\" \"float B\" 0.3\nFilm \"spectral\"\nAccelerator \"bvh\"\n\
+        "Sampler \"pmj02bn\"\nPixelFilter \"mitchell\" \"float B\" 0.3\nFilm \"spectral\"\nAccelerator \"bvh\"\n\
          Option \"bool disablepixeljitter\" true\nWorldBegin\nTexture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" 4\n\
          MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\n\
          Shape \"curve\" \"point3 P\" [ 0 0 0 1 1 1 2 2 2 3 3 3 ]\nLightSource \"goniometric\"\n\

@@ -6,15 +6,23 @@
 //! The Sobol sampler pads 2D Sobol points across dimension pairs with hash-based Owen
 //! scrambling and index shuffling (Burley, "Practical Hash-based Owen Scrambling",
 //! JCGT 2020), which keeps every pair well stratified and decorrelates the pairs.
+//! Halton points use the primes of their dimension pair as bases (halton.rs), and
+//! the stratified sampler jitters within a per-pixel random order of strata
+//! (stratified.rs). Streams not tied to a pixel (photons) have no strata count, so a
+//! stratified sampler draws independent numbers there.
 
+mod halton;
 mod sobol;
+mod stratified;
 
 use glam::Vec2;
 
 use radiant_math::hash::{hash_u64s, mix64, u32_to_unit_f32};
 use radiant_scene::SamplerKind;
 
+pub use halton::{PRIME_COUNT, PRIMES, randomized_radical_inverse};
 pub use sobol::{owen_scramble, scrambled_sobol, sobol_u32};
+pub use stratified::{permute, stratified_1d, stratified_2d};
 
 /// The sampler state for one pixel sample.
 #[derive(Clone, Debug)]
@@ -24,6 +32,8 @@ pub struct PixelSample {
     pixel_key: u64,
     index: u32,
     dim: u32,
+    /// A stream not tied to a pixel ([`PixelSample::for_stream`]).
+    in_stream: bool,
 }
 
 impl PixelSample {
@@ -34,6 +44,7 @@ impl PixelSample {
             pixel_key: hash_u64s(&[x as u64, y as u64, seed]),
             index,
             dim: 0,
+            in_stream: false,
         }
     }
 
@@ -45,6 +56,7 @@ impl PixelSample {
             pixel_key: hash_u64s(&[stream, 0x5eed_5eed, seed]),
             index,
             dim: 0,
+            in_stream: true,
         }
     }
 
@@ -65,24 +77,38 @@ impl PixelSample {
 
     /// One uniform number in [0, 1).
     pub fn get_1d(&mut self) -> f32 {
+        let dim = self.dim;
         let key = self.next_key();
         match self.kind {
-            SamplerKind::Independent => u32_to_unit_f32(mix64(key ^ self.index as u64) as u32),
+            SamplerKind::Independent => independent(key, self.index),
             SamplerKind::Sobol => {
                 let i = shuffled_index(self.index, key);
                 u32_to_unit_f32(scrambled_sobol(0, i, (key >> 32) as u32))
+            }
+            SamplerKind::Halton { randomization } => {
+                let prime = 2 * dim as usize;
+                if prime < PRIME_COUNT {
+                    randomized_radical_inverse(self.index, prime, key, randomization)
+                } else {
+                    independent(key, self.index)
+                }
+            }
+            SamplerKind::Stratified { x, y, jitter } => {
+                if self.in_stream {
+                    independent(key, self.index)
+                } else {
+                    stratified_1d(self.index, x * y, jitter, key)
+                }
             }
         }
     }
 
     /// A pair of uniform numbers in [0, 1)^2, stratified together.
     pub fn get_2d(&mut self) -> Vec2 {
+        let dim = self.dim;
         let key = self.next_key();
         match self.kind {
-            SamplerKind::Independent => {
-                let h = mix64(key ^ self.index as u64);
-                Vec2::new(u32_to_unit_f32(h as u32), u32_to_unit_f32((h >> 32) as u32))
-            }
+            SamplerKind::Independent => independent_2d(key, self.index),
             SamplerKind::Sobol => {
                 let i = shuffled_index(self.index, key);
                 let h = mix64(key);
@@ -91,8 +117,40 @@ impl PixelSample {
                     u32_to_unit_f32(scrambled_sobol(1, i, (h >> 32) as u32)),
                 )
             }
+            SamplerKind::Halton { randomization } => {
+                let prime = 2 * dim as usize;
+                if prime + 1 < PRIME_COUNT {
+                    Vec2::new(
+                        randomized_radical_inverse(self.index, prime, key, randomization),
+                        randomized_radical_inverse(
+                            self.index,
+                            prime + 1,
+                            mix64(key),
+                            randomization,
+                        ),
+                    )
+                } else {
+                    independent_2d(key, self.index)
+                }
+            }
+            SamplerKind::Stratified { x, y, jitter } => {
+                if self.in_stream {
+                    independent_2d(key, self.index)
+                } else {
+                    stratified_2d(self.index, x, y, jitter, key)
+                }
+            }
         }
     }
+}
+
+fn independent(key: u64, index: u32) -> f32 {
+    u32_to_unit_f32(mix64(key ^ index as u64) as u32)
+}
+
+fn independent_2d(key: u64, index: u32) -> Vec2 {
+    let h = mix64(key ^ index as u64);
+    Vec2::new(u32_to_unit_f32(h as u32), u32_to_unit_f32((h >> 32) as u32))
 }
 
 /// Burley's sample-index shuffle: the index is Owen-scrambled as if it were a binary

@@ -13,7 +13,8 @@
 //!   are read as it, with a warning), `float whitebalance` 0 (none; 6500 K for a
 //!   camera sensor).
 //! - `Sampler`: `integer pixelsamples` 16, `integer seed` 0; `"stratified"` uses
-//!   `xsamples` × `ysamples` (4 × 4).
+//!   `xsamples` × `ysamples` (4 × 4) and `bool jitter` true; `"halton"` and `"sobol"`
+//!   read `string randomization` (`permutedigits` and `fastowen` by default).
 //! - `PixelFilter`: `float xradius`/`yradius`; box 0.5, gaussian 1.5 (`sigma` 0.5),
 //!   triangle 2.
 
@@ -241,26 +242,56 @@ impl Parser {
         let (name, _) = self.string_arg("Sampler")?;
         let ps = self.param_list()?;
         self.require_options("Sampler", loc)?;
-        let kind = if name == "independent" {
-            SamplerKind::Independent
-        } else {
-            SamplerKind::Sobol
+        let at = |param: &str| {
+            ps.lookup(param)
+                .map_or_else(|| loc.clone(), |p| p.loc.clone())
         };
-        if name != "independent" && name != "sobol" {
-            self.warn(
-                loc,
-                format!("Sampler \"{name}\": rendered with radiant's Owen-scrambled Sobol sampler"),
-            );
-        }
-        // pbrt's randomization choices and stratified jitter have no counterpart.
-        ps.lookup("randomization");
-        ps.lookup("jitter");
-        let pixel_samples = if name == "stratified" {
-            ps.count("xsamples", 4)?
-                .checked_mul(ps.count("ysamples", 4)?)
-                .unwrap_or(0)
-        } else {
-            ps.count("pixelsamples", 16)?
+        let randomization = |default: &str| -> Result<DigitRandomization, SceneError> {
+            match ps.string("randomization", default.into())?.as_str() {
+                "none" => Ok(DigitRandomization::None),
+                "permutedigits" => Ok(DigitRandomization::PermuteDigits),
+                "owen" | "fastowen" => Ok(DigitRandomization::Owen),
+                other => Err(SceneError::at(
+                    &at("randomization"),
+                    format!(
+                        "unknown randomization \"{other}\" (none, permutedigits, fastowen, owen)"
+                    ),
+                )),
+            }
+        };
+        let (kind, pixel_samples) = match name.as_str() {
+            "independent" => (SamplerKind::Independent, ps.count("pixelsamples", 16)?),
+            "halton" => (
+                SamplerKind::Halton {
+                    randomization: randomization("permutedigits")?,
+                },
+                ps.count("pixelsamples", 16)?,
+            ),
+            "stratified" => {
+                let x = ps.count("xsamples", 4)?;
+                let y = ps.count("ysamples", 4)?;
+                let jitter = ps.bool("jitter", true)?;
+                let n = x.checked_mul(y).unwrap_or(0);
+                (SamplerKind::Stratified { x, y, jitter }, n)
+            }
+            _ => {
+                let r = randomization("fastowen")?;
+                if name != "sobol" && name != "paddedsobol" {
+                    self.warn(
+                        loc,
+                        format!("Sampler \"{name}\": rendered with radiant's Owen-scrambled Sobol sampler"),
+                    );
+                }
+                if r != DigitRandomization::Owen {
+                    self.warn(
+                        &at("randomization"),
+                        format!(
+                            "Sampler \"{name}\": radiant's Sobol points are always Owen-scrambled; \"randomization\" ignored"
+                        ),
+                    );
+                }
+                (SamplerKind::Sobol, ps.count("pixelsamples", 16)?)
+            }
         };
         if pixel_samples == 0 {
             return Err(SceneError::at(

@@ -1,0 +1,199 @@
+//! Randomised Halton points (Halton 1960): coordinate d of point i is the radical inverse
+//! of i in the d-th prime base. Each pixel gets its own randomisation of the digits, so
+//! pixels are decorrelated and every point is uniformly distributed while the points of
+//! one pixel keep the sequence's stratification: in base b, any b^k consecutive indices
+//! starting at a multiple of b^k put one point in each interval [j/b^k, (j+1)/b^k).
+//!
+//! Digits are permuted by affine maps d ↦ (a·d + c) mod b (b prime, a ≠ 0: a bijection),
+//! drawn from a hash. With c uniform every output digit is uniform, which is what makes
+//! the estimate unbiased; Faure's (1992) permutations and Owen's (1995) nested scrambling
+//! differ in what the hash depends on: the digit position alone, or the position and
+//! every digit before it. Digits are produced until b^-k falls below 2^-32, so a
+//! scrambled point has a random tail instead of trailing zeros.
+
+use radiant_math::hash::{mix64, u32_to_unit_f32};
+use radiant_scene::DigitRandomization;
+
+use super::sobol::{scrambled_sobol, sobol_u32};
+
+/// How many primes the sampler knows: dimension pairs past `PRIMES.len() / 2` are
+/// independent random numbers (their bases would be too large to stratify anything at
+/// practical sample counts anyway).
+pub const PRIME_COUNT: usize = 1024;
+
+/// The first [`PRIME_COUNT`] primes, by trial division at compile time.
+pub static PRIMES: [u32; PRIME_COUNT] = first_primes();
+
+const fn first_primes() -> [u32; PRIME_COUNT] {
+    let mut primes = [0u32; PRIME_COUNT];
+    let mut count = 0;
+    let mut candidate = 2u32;
+    while count < PRIME_COUNT {
+        let mut is_prime = true;
+        let mut j = 0;
+        while j < count && primes[j] * primes[j] <= candidate {
+            if candidate % primes[j] == 0 {
+                is_prime = false;
+                break;
+            }
+            j += 1;
+        }
+        if is_prime {
+            primes[count] = candidate;
+            count += 1;
+        }
+        candidate += 1;
+    }
+    primes
+}
+
+/// The radical inverse of `index` in base `PRIMES[prime]`, its digits randomised as
+/// `randomization` says with the hash `key` (one key per pixel and dimension).
+pub fn randomized_radical_inverse(
+    index: u32,
+    prime: usize,
+    key: u64,
+    randomization: DigitRandomization,
+) -> f32 {
+    if prime == 0 {
+        // Base 2 is the van der Corput sequence, Sobol's first dimension: its scrambles
+        // are bit operations on the reversed index.
+        let bits = match randomization {
+            DigitRandomization::None => sobol_u32(0, index),
+            DigitRandomization::PermuteDigits => sobol_u32(0, index) ^ (key >> 32) as u32,
+            DigitRandomization::Owen => scrambled_sobol(0, index, (key >> 32) as u32),
+        };
+        return u32_to_unit_f32(bits);
+    }
+    let base = PRIMES[prime] as u64;
+    let inv_base = 1.0 / base as f64;
+    let mut rest = index as u64;
+    let mut weight = inv_base;
+    let mut value = 0.0f64;
+    // The hash the next digit's permutation is drawn from: for Owen scrambling it takes
+    // in every digit produced so far, so each prefix interval is permuted on its own.
+    let mut prefix = key;
+    let mut position = 0u64;
+    while weight > 1.0 / 4_294_967_296.0 {
+        let digit = rest % base;
+        rest /= base;
+        let permuted = match randomization {
+            DigitRandomization::None => digit,
+            DigitRandomization::PermuteDigits => {
+                affine_permutation(digit, base, mix64(key ^ position.wrapping_mul(PHI)))
+            }
+            DigitRandomization::Owen => {
+                let p = affine_permutation(digit, base, prefix);
+                prefix = mix64(prefix ^ (digit + 1).wrapping_mul(PHI));
+                p
+            }
+        };
+        value += permuted as f64 * weight;
+        weight *= inv_base;
+        position += 1;
+        if rest == 0 && randomization == DigitRandomization::None {
+            break;
+        }
+    }
+    // Rounding must not reach 1: the largest f32 below 1.
+    (value as f32).min(1.0 - f32::EPSILON / 2.0)
+}
+
+const PHI: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// d ↦ (a·d + c) mod b with a ∈ [1, b), c ∈ [0, b) taken from `hash`: a permutation of
+/// the digits of a prime base, and c makes every digit equally likely.
+#[inline]
+fn affine_permutation(digit: u64, base: u64, hash: u64) -> u64 {
+    let a = 1 + (hash >> 32) % (base - 1).max(1);
+    let c = (hash & 0xffff_ffff) % base;
+    (a * digit + c) % base
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_prime_table_holds_the_primes() {
+        assert_eq!(&PRIMES[..10], &[2, 3, 5, 7, 11, 13, 17, 19, 23, 29]);
+        // The 1024th prime.
+        assert_eq!(PRIMES[PRIME_COUNT - 1], 8161);
+    }
+
+    #[test]
+    fn unscrambled_points_are_the_radical_inverse() {
+        let r = |i, p| randomized_radical_inverse(i, p, 0, DigitRandomization::None);
+        // 6 = 110 in base 2 → 0.011 = 3/8; 5 = 12 in base 3 → 0.21 = 2/3 + 1/9;
+        // 7 = 12 in base 5 → 0.21 = 2/5 + 1/25.
+        assert_eq!(r(6, 0), 0.375);
+        assert!((r(5, 1) - (2.0 / 3.0 + 1.0 / 9.0)).abs() < 1e-6);
+        assert!((r(7, 2) - (2.0 / 5.0 + 1.0 / 25.0)).abs() < 1e-6);
+        assert_eq!(r(0, 5), 0.0);
+    }
+
+    /// b^k consecutive points from a multiple of b^k fill the b^k intervals once each,
+    /// with every randomisation, in several bases.
+    #[test]
+    fn every_randomisation_keeps_the_intervals_stratified() {
+        for randomization in [
+            DigitRandomization::None,
+            DigitRandomization::PermuteDigits,
+            DigitRandomization::Owen,
+        ] {
+            for (prime, k) in [(0usize, 8u32), (1, 5), (2, 3), (9, 2), (100, 1)] {
+                let b = PRIMES[prime];
+                let n = b.pow(k);
+                for start in [0, n, 7 * n] {
+                    let mut seen = vec![false; n as usize];
+                    for i in start..start + n {
+                        let v = randomized_radical_inverse(
+                            i,
+                            prime,
+                            0xabc ^ prime as u64,
+                            randomization,
+                        );
+                        // The unscrambled points lie on the interval ends, where the
+                        // f32 rounding may fall just short.
+                        let slack = if randomization == DigitRandomization::None {
+                            1e-3
+                        } else {
+                            0.0
+                        };
+                        let cell = (v as f64 * n as f64 + slack) as usize;
+                        assert!(!seen[cell], "{randomization:?} base {b} index {i}");
+                        seen[cell] = true;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Over many keys a scrambled coordinate is uniform: Pearson's chi-square over 32
+    /// bins for a fixed index, in bases 2, 3 and 7919 (4000 keys, 31 degrees of freedom,
+    /// the 0.999 quantile is 61.1).
+    #[test]
+    fn scrambled_points_are_uniform_over_keys() {
+        for randomization in [DigitRandomization::PermuteDigits, DigitRandomization::Owen] {
+            for prime in [0usize, 1, 999] {
+                for index in [0u32, 5, 1000] {
+                    let n = 4000;
+                    let mut bins = [0u32; 32];
+                    for key in 0..n {
+                        let v = randomized_radical_inverse(index, prime, mix64(key), randomization);
+                        bins[(v * 32.0) as usize] += 1;
+                    }
+                    let expected = n as f64 / 32.0;
+                    let chi2: f64 = bins
+                        .iter()
+                        .map(|&o| (o as f64 - expected).powi(2) / expected)
+                        .sum();
+                    assert!(
+                        chi2 < 61.1,
+                        "{randomization:?} prime {prime} index {index}: {chi2}"
+                    );
+                }
+            }
+        }
+    }
+}
