@@ -32,7 +32,7 @@ const fn first_primes() -> [u32; PRIME_COUNT] {
         let mut is_prime = true;
         let mut j = 0;
         while j < count && primes[j] * primes[j] <= candidate {
-            if candidate % primes[j] == 0 {
+            if candidate.is_multiple_of(primes[j]) {
                 is_prime = false;
                 break;
             }
