@@ -11,6 +11,7 @@
 //! every digit before it. Digits are produced until b^-k falls below 2^-32, so a
 //! scrambled point has a random tail instead of trailing zeros.
 
+use radiant_math::ONE_MINUS_EPSILON;
 use radiant_math::hash::{mix64, u32_to_unit_f32};
 use radiant_scene::DigitRandomization;
 
@@ -95,8 +96,8 @@ pub fn randomized_radical_inverse(
             break;
         }
     }
-    // Rounding must not reach 1: the largest f32 below 1.
-    (value as f32).min(1.0 - f32::EPSILON / 2.0)
+    // Rounding must not reach 1.
+    (value as f32).min(ONE_MINUS_EPSILON)
 }
 
 const PHI: u64 = 0x9e37_79b9_7f4a_7c15;

@@ -6,6 +6,7 @@
 //! with a fresh order, so any sample count stays unbiased.
 
 use glam::Vec2;
+use radiant_math::ONE_MINUS_EPSILON;
 use radiant_math::hash::{mix64, u32_to_unit_f32};
 
 /// Sample `index`'s 1D value among `n` strata, the order drawn from `key`.
@@ -16,7 +17,7 @@ pub fn stratified_1d(index: u32, n: u32, jitter: bool, key: u64) -> f32 {
     } else {
         0.5
     };
-    ((stratum as f32 + offset) / n as f32).min(1.0 - f32::EPSILON / 2.0)
+    ((stratum as f32 + offset) / n as f32).min(ONE_MINUS_EPSILON)
 }
 
 /// Sample `index`'s 2D value in an `x` × `y` grid of strata.
@@ -29,10 +30,9 @@ pub fn stratified_2d(index: u32, x: u32, y: u32, jitter: bool, key: u64) -> Vec2
     } else {
         (0.5, 0.5)
     };
-    let below_one = 1.0 - f32::EPSILON / 2.0;
     Vec2::new(
-        ((sx as f32 + ox) / x as f32).min(below_one),
-        ((sy as f32 + oy) / y as f32).min(below_one),
+        ((sx as f32 + ox) / x as f32).min(ONE_MINUS_EPSILON),
+        ((sy as f32 + oy) / y as f32).min(ONE_MINUS_EPSILON),
     )
 }
 
