@@ -205,3 +205,47 @@ Shape "sphere" "float radius" 0.25
     // image is not trivially white.
     assert!(mean < 0.999, "mean {mean}: the bump map had no effect");
 }
+
+/// The bump map's finite differences span half the pixel footprint (pbrt-v4's
+/// du = (|∂u/∂x| + |∂u/∂y|) / 2): next to a step in the height a camera ray with a
+/// wide footprint sees the step and tilts, while a lookup without a footprint
+/// (step 0.0005) does not; far from the step both stay flat.
+#[test]
+fn bump_differences_span_the_pixel_footprint() {
+    use radiant::render::camera::RaySpread;
+    let dir = temp_dir("footprint-step");
+    // Checks of width 1/2 in u: the height steps from 0 to 0.05 at u = 1/2 (x = 0).
+    let desc = parse_in(
+        &square(
+            "Texture \"steps\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 1 \
+               \"float tex1\" 0 \"float tex2\" 0.05\n\
+             Material \"diffuse\" \"texture displacement\" \"steps\"",
+            false,
+        ),
+        &dir,
+    );
+    let (mut world, _) = World::build(&desc).unwrap_or_else(|e| panic!("{e}"));
+    // 0.1 scene units per pixel: ∂u/∂x and ∂u/∂y of about 0.05 on this square.
+    world.ray_spread = RaySpread {
+        angle: 0.0,
+        offset: 0.1,
+    };
+    let down = Vec3::new(0.0, 0.0, -1.0);
+    let near_step = Ray::new(Vec3::new(-0.02, 0.3, 1.0), down);
+    let point = world.intersect(&near_step, f32::INFINITY).unwrap();
+    assert!(point.ns.z > 1.0 - 1e-6, "no footprint: {:?}", point.ns);
+    let wide = world
+        .intersect_with_footprint(&near_step, f32::INFINITY, 0.0)
+        .unwrap();
+    assert!(
+        wide.ns.z < 0.99 && wide.ns.x < -0.1,
+        "with a footprint the step tilts the normal away from +u: {:?}",
+        wide.ns
+    );
+    let far = Ray::new(Vec3::new(-0.6, 0.3, 1.0), down);
+    let flat = world
+        .intersect_with_footprint(&far, f32::INFINITY, 0.0)
+        .unwrap();
+    assert!(flat.ns.z > 1.0 - 1e-6, "far from the step: {:?}", flat.ns);
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -98,6 +98,7 @@ fn curved_bilinear_light_is_sampled_consistently() {
     s.area_light = Some(AreaLightDesc {
         l: Rgb::splat(1.0),
         two_sided: true,
+        image: None,
     });
     desc.shapes.push(s);
     let world = build(&desc);

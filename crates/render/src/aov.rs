@@ -104,11 +104,9 @@ pub fn render_aovs(
                 s.weight += wt;
                 let Some(cr) = cs.ray else { continue };
                 let ray = cr.ray;
-                let Some(mut hit) = world.intersect(&ray, f32::INFINITY) else {
+                let Some(hit) = world.intersect_with_footprint(&ray, f32::INFINITY, 0.0) else {
                     continue;
                 };
-                let travelled = hit.t * ray.d.length();
-                world.add_footprint(&mut hit, ray.d, travelled);
                 let wo_world = -ray.d.normalize();
                 if set.albedo {
                     let material = world.material_at(&hit, wo_world);

@@ -7,7 +7,8 @@
 //! - `sample_li` gives I(ω) / d² towards the receiver: checked against the image
 //!   pixel the direction falls in, worked out by hand.
 //! - Scenes with `power` (or `illuminance`) build lights whose luminance power is the
-//!   number given; the direct irradiance on a sphere of receivers around a point-like
+//!   number given times `scale` (pbrt-v4 multiplies the scale by power / k_e), an area
+//!   light's image counted by its mean luminance; the direct irradiance on a sphere of receivers around a point-like
 //!   light with `power` Φ is Φ / (4π d²) averaged over the sphere.
 
 use std::path::{Path, PathBuf};
@@ -278,6 +279,10 @@ fn power_and_illuminance_set_the_emission() {
         .map(|k| Rgb::new(1.0 + (k % 5) as f32, 0.5, 2.0))
         .collect();
     write_image(&dir, "proj.pfm", 12, 8, proj);
+    let glow: Vec<Rgb> = (0..6 * 3)
+        .map(|k| Rgb::new(0.2 + k as f32, 1.0, 0.1 * (k % 4) as f32))
+        .collect();
+    write_image(&dir, "glow.pfm", 6, 3, glow);
     let world = build(
         &dir,
         r#"
@@ -287,9 +292,14 @@ fn power_and_illuminance_set_the_emission() {
         LightSource "projection" "string filename" "proj.pfm" "float fov" 35 "float power" 45
         Rotate 30 1 0 0
         LightSource "projection" "string filename" "proj.pfm" "float fov" 120 "float scale" 0.1 "float power" 8
-        LightSource "distant" "blackbody L" 5000 "float illuminance" 12
+        LightSource "distant" "blackbody L" 5000 "float illuminance" 12 "float scale" 2
         AttributeBegin
-          AreaLightSource "diffuse" "rgb L" [3 2 1] "float power" 20
+          AreaLightSource "diffuse" "string filename" "glow.pfm" "float power" 5 "float scale" 2
+          Translate 0 -3 0
+          Shape "disk" "float radius" 0.7
+        AttributeEnd
+        AttributeBegin
+          AreaLightSource "diffuse" "rgb L" [3 2 1] "float power" 20 "float scale" 1.5
           Translate 0 0 5
           Shape "sphere" "float radius" 0.5
         AttributeEnd
@@ -308,7 +318,7 @@ fn power_and_illuminance_set_the_emission() {
         .filter(|l| !matches!(l, Light::Area(_) | Light::Distant { .. }))
         .map(lum)
         .collect();
-    let want = [100.0, 250.0, 60.0, 45.0, 8.0];
+    let want = [100.0 * 7.0, 250.0, 60.0 * 3.0, 45.0, 8.0 * 0.1];
     assert_eq!(point_like.len(), want.len());
     for (got, want) in point_like.iter().zip(want) {
         assert!((got - want).abs() < 2e-4 * want, "power {got} vs {want}");
@@ -319,8 +329,8 @@ fn power_and_illuminance_set_the_emission() {
         .filter(|l| matches!(l, Light::Area(_)))
         .map(lum)
         .sum();
-    // One sphere and one triangle light: 20 + 9.
-    assert!((area - 29.0).abs() < 2e-4 * 29.0, "area power {area}");
+    // The image disk, a sphere and a triangle: 5 × 2 + 20 × 1.5 + 9.
+    assert!((area - 49.0).abs() < 2e-4 * 49.0, "area power {area}");
     let distant = world
         .lights
         .iter()
@@ -329,7 +339,7 @@ fn power_and_illuminance_set_the_emission() {
             _ => None,
         })
         .unwrap();
-    assert!((distant.luminance() - 12.0).abs() < 1e-4 * 12.0);
+    assert!((distant.luminance() - 24.0).abs() < 1e-4 * 24.0);
     // The spectrum's shape is kept: the spot stays as red as its I.
     let spot = world
         .lights
@@ -422,6 +432,18 @@ fn malformed_light_images_are_located_errors() {
             3,
             1,
             &["\"projection\" needs a \"filename\""][..],
+        ),
+        (
+            "missing_area_light_image.pbrt",
+            3,
+            29,
+            &["cannot read area light image", "no-such-emission.exr"][..],
+        ),
+        (
+            "unreadable_area_light_image.pbrt",
+            4,
+            5,
+            &["cannot read area light image", "unreadable.pfm"][..],
         ),
     ] {
         let path = corpus(scene);

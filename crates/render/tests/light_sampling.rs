@@ -53,6 +53,7 @@ fn emitter(geometry: Geometry, render_from_object: Transform, two_sided: bool) -
     s.area_light = Some(AreaLightDesc {
         l: Rgb::splat(1.0),
         two_sided,
+        image: None,
     });
     s
 }
@@ -187,7 +188,7 @@ fn pdf_towards(world: &World, ctx: &LightSampleContext, wi: Vec3) -> f32 {
     let Light::Area(area) = light else {
         unreachable!("primitives only carry area lights")
     };
-    if area.radiance(hit.ng, -wi).is_black() {
+    if area.radiance(hit.ng, hit.uv, -wi).is_black() {
         return 0.0;
     }
     sampler.pmf(ctx, hit.light as usize) * light.pdf_li(ctx, wi, Some(&hit.light_hit()))
@@ -926,7 +927,7 @@ fn mis_weighted_direct_light_has_the_mean_of_each_strategy() {
                     };
                     let pdf = world.light_sampler.pmf(&ctx, h.light as usize)
                         * a.pdf_li(&ctx, &h.light_hit());
-                    (a.radiance(h.ng, -wi).g, pdf)
+                    (a.radiance(h.ng, h.uv, -wi).g, pdf)
                 }
                 Some(_) => (0.0, 0.0),
                 None => pdf_environment(&world, &ctx, wi),

@@ -234,13 +234,17 @@ fn render_floor(desc: &SceneDesc, supersample: u32) -> FloorImage {
                         y as f32 + (j as f32 + 0.5) / n as f32,
                     );
                     let ray = cam.generate_ray(raster, Vec2::splat(0.5)).unwrap().ray;
-                    let Some(mut hit) = world.intersect(&ray, f32::INFINITY) else {
+                    // One ray per pixel filters by its footprint; the supersampled
+                    // reference takes point lookups.
+                    let hit = if n == 1 {
+                        world.intersect_with_footprint(&ray, f32::INFINITY, 0.0)
+                    } else {
+                        world.intersect(&ray, f32::INFINITY)
+                    };
+                    let Some(hit) = hit else {
                         continue;
                     };
                     let travelled = hit.t * ray.d.length();
-                    if n == 1 {
-                        world.add_footprint(&mut hit, ray.d, travelled);
-                    }
                     sum += world.material_at(&hit, -ray.d).diffuse_albedo().r as f64;
                     hits += 1;
                     dist = travelled;
@@ -497,4 +501,208 @@ Shape "trianglemesh" "integer indices" [0 1 2 0 2 3]
     };
     assert_eq!(at(0.25, 0.25), want(0.8));
     assert_eq!(at(0.75, 0.25), want(0.2));
+}
+
+/// Every parameter pbrt-v4 lets a texture give to the layered materials and
+/// conductors: at a hit in either check of a checkerboard the material is exactly the
+/// one with that check's constant, and the two constants give different materials.
+#[test]
+fn layered_and_conductor_parameters_take_textures() {
+    use radiant_render::geometry::Ray;
+    let dir = temp_dir("layered-params");
+    let cases = [
+        ("coateddiffuse", "float", "thickness", "0.01", "0.3"),
+        ("coateddiffuse", "float", "g", "-0.5", "0.7"),
+        (
+            "coateddiffuse",
+            "spectrum",
+            "albedo",
+            "[0.2 0.3 0.4]",
+            "[0.8 0.7 0.6]",
+        ),
+        ("coateddiffuse", "float", "roughness", "0", "0.3"),
+        (
+            "coatedconductor",
+            "float",
+            "interface.roughness",
+            "0.05",
+            "0.4",
+        ),
+        (
+            "coatedconductor",
+            "float",
+            "conductor.roughness",
+            "0",
+            "0.2",
+        ),
+        (
+            "coatedconductor",
+            "spectrum",
+            "conductor.eta",
+            "[0.2 0.9 1.1]",
+            "[1.5 1.0 0.5]",
+        ),
+        (
+            "coatedconductor",
+            "spectrum",
+            "reflectance",
+            "[0.9 0.5 0.2]",
+            "[0.3 0.6 0.9]",
+        ),
+        (
+            "conductor",
+            "spectrum",
+            "reflectance",
+            "[0.9 0.5 0.2]",
+            "[0.3 0.6 0.9]",
+        ),
+        ("conductor", "spectrum", "k", "[3 2.5 2]", "[1 1.2 1.4]"),
+    ];
+    for (ty, kind, param, a, b) in cases {
+        let value = |v: &str| {
+            if kind == "float" {
+                format!("\"float {param}\" {v}")
+            } else {
+                format!("\"rgb {param}\" {v}")
+            }
+        };
+        let tex_value = |name: &str, v: &str| {
+            if kind == "float" {
+                format!("\"float {name}\" {v}")
+            } else {
+                format!("\"rgb {name}\" {v}")
+            }
+        };
+        // The coat's medium scatters, so that g and the albedo matter.
+        let extra = if ty == "coateddiffuse" && param != "albedo" {
+            "\"rgb albedo\" [0.5 0.5 0.5]"
+        } else {
+            ""
+        };
+        let scene = |material_param: &str| {
+            format!(
+                "WorldBegin\n\
+                 Texture \"t\" \"{kind}\" \"checkerboard\" {} {}\n\
+                 Material \"{ty}\" {material_param} {extra}\n\
+                 Shape \"trianglemesh\" \"integer indices\" [0 1 2 0 2 3] \
+                   \"point3 P\" [0 0 0  1 0 0  1 1 0  0 1 0] \"point2 uv\" [0 0 2 0 2 2 0 2]\n",
+                tex_value("tex1", a),
+                tex_value("tex2", b)
+            )
+        };
+        let material_at = |desc: &SceneDesc, x: f32, y: f32| {
+            let (world, _) = World::build(desc).unwrap_or_else(|e| panic!("{e}"));
+            let ray = Ray::new(Vec3::new(x, y, 1.0), Vec3::new(0.0, 0.0, -1.0));
+            let hit = world.intersect(&ray, f32::INFINITY).expect("the square");
+            world.material_at(&hit, Vec3::Z)
+        };
+        let textured = parse_in(&scene(&format!("\"texture {param}\" \"t\"")), &dir);
+        assert!(
+            textured.warnings.is_empty(),
+            "{ty} {param}: {:?}",
+            textured.warnings
+        );
+        let first = parse_in(&scene(&value(a)), &dir);
+        let second = parse_in(&scene(&value(b)), &dir);
+        let (m1, m2) = (
+            material_at(&first, 0.25, 0.25),
+            material_at(&second, 0.75, 0.25),
+        );
+        assert_ne!(m1, m2, "{ty} {param}: the two values give one material");
+        assert_eq!(
+            material_at(&textured, 0.25, 0.25),
+            m1,
+            "{ty} {param} in check 1"
+        );
+        assert_eq!(
+            material_at(&textured, 0.75, 0.25),
+            m2,
+            "{ty} {param} in check 2"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A far sphere and disk under a fine checker image, one ray per pixel with the
+/// camera's footprint: their (u, v) derivatives come from ∂p/∂u and ∂p/∂v, so
+/// trilinear and EWA filtering average the checks to grey in every covered pixel,
+/// where point lookups alias (half the pixels black, half white).
+#[test]
+fn quadrics_filter_to_grey_by_their_uv_footprint() {
+    let dir = temp_dir("quadrics");
+    let checks = image::RgbImage::from_fn(256, 256, |x, y| {
+        image::Rgb([if (x / 2 + y / 2) % 2 == 0 { 255 } else { 0 }; 3])
+    });
+    checks.save(dir.join("checks.png")).unwrap();
+    const N: u32 = 64;
+    for (shape, placement) in [
+        ("Shape \"sphere\" \"float radius\" 1", "Rotate 90 1 0 0"),
+        ("Shape \"disk\" \"float radius\" 1", ""),
+        (
+            "Shape \"sphere\" \"float radius\" 1 \"float zmin\" -0.5 \"float zmax\" 0.8",
+            "Rotate 70 1 0 0",
+        ),
+    ] {
+        let mut variance = Vec::new();
+        for filter in ["point", "trilinear", "ewa"] {
+            let desc = parse_in(
+                &format!(
+                    "LookAt 0 0 60  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 4\n\
+                     Film \"rgb\" \"integer xresolution\" {N} \"integer yresolution\" {N}\n\
+                     WorldBegin\n\
+                     Texture \"checks\" \"spectrum\" \"imagemap\" \"string filename\" \"checks.png\" \
+                       \"string filter\" \"{filter}\" \"string encoding\" \"linear\" \
+                       \"float uscale\" 4 \"float vscale\" 2\n\
+                     Material \"diffuse\" \"texture reflectance\" \"checks\"\n\
+                     {placement}\n{shape}\n"
+                ),
+                &dir,
+            );
+            let (mut world, _) = World::build(&desc).unwrap_or_else(|e| panic!("{e}"));
+            let mut warnings = Vec::new();
+            let cam = camera::from_desc(&desc.camera, &desc.film, (N, N), &mut warnings).unwrap();
+            world.ray_spread = RaySpread::of_camera(&cam, (N, N), 1);
+            let mut values = Vec::new();
+            for y in 0..N {
+                for x in 0..N {
+                    // Pixels whose four corners all hit the shape: fully covered.
+                    let corner_hits =
+                        [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+                            .iter()
+                            .all(|&(dx, dy)| {
+                                let r = Vec2::new(x as f32 + dx, y as f32 + dy);
+                                let ray = cam.generate_ray(r, Vec2::splat(0.5)).unwrap().ray;
+                                world.intersect(&ray, f32::INFINITY).is_some()
+                            });
+                    if !corner_hits {
+                        continue;
+                    }
+                    let raster = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                    let ray = cam.generate_ray(raster, Vec2::splat(0.5)).unwrap().ray;
+                    let hit = world
+                        .intersect_with_footprint(&ray, f32::INFINITY, 0.0)
+                        .unwrap();
+                    values.push(world.material_at(&hit, -ray.d).diffuse_albedo().r as f64);
+                }
+            }
+            assert!(
+                values.len() > 100,
+                "{shape}: {} covered pixels",
+                values.len()
+            );
+            let mean = values.iter().sum::<f64>() / values.len() as f64;
+            let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / values.len() as f64;
+            assert!((mean - 0.5).abs() < 0.1, "{shape} {filter}: mean {mean}");
+            variance.push(var);
+        }
+        let [point, trilinear, ewa] = variance[..] else {
+            unreachable!()
+        };
+        assert!(point > 0.1, "{shape}: point lookups should alias: {point}");
+        assert!(
+            trilinear < 0.01 && ewa < 0.01,
+            "{shape}: filtered variance {trilinear} (trilinear), {ewa} (EWA)"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

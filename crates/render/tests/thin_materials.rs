@@ -258,6 +258,46 @@ fn mix_chooses_the_second_material_with_probability_amount_deterministically() {
 }
 
 #[test]
+fn a_textured_mix_amount_is_read_at_each_hit() {
+    // A checkerboard amount: 0.2 where u < 1/2 (x < 0), 0.9 where u > 1/2.
+    let w = world(
+        "WorldBegin\n\
+         Texture \"amt\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 1 \
+           \"float tex1\" 0.2 \"float tex2\" 0.9\n\
+         MakeNamedMaterial \"a\" \"string type\" \"diffuse\" \"rgb reflectance\" [ 0.8 0.8 0.8 ]\n\
+         MakeNamedMaterial \"b\" \"string type\" \"conductor\" \"rgb reflectance\" [ 0.9 0.9 0.9 ]\n\
+         Material \"mix\" \"string materials\" [ \"a\" \"b\" ] \"texture amount\" \"amt\"\n\
+         Shape \"trianglemesh\" \"point3 P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0 ] \
+           \"point2 uv\" [ 0 0  1 0  1 1  0 1 ] \"integer indices\" [ 0 1 2  0 2 3 ]\n",
+    );
+    let mut rng = Pcg32::new(7, 2);
+    let n = 20_000;
+    let mut second = [0u32; 2];
+    let mut seen = [0u32; 2];
+    for _ in 0..n {
+        let x = 1.8 * rng.uniform() - 0.9;
+        if x.abs() < 0.02 {
+            continue;
+        }
+        let o = Vec3::new(x, 1.8 * rng.uniform() - 0.9, 1.0);
+        let ray = Ray::new(o, -Vec3::Z);
+        let hit = w.intersect(&ray, f32::INFINITY).expect("the quad");
+        let m = w.material_at(&hit, Vec3::Z);
+        let side = (x > 0.0) as usize;
+        seen[side] += 1;
+        second[side] += m.is_specular() as u32;
+    }
+    for (side, p) in [(0usize, 0.2f64), (1, 0.9)] {
+        let f = second[side] as f64 / seen[side] as f64;
+        let sd = (p * (1.0 - p) / seen[side] as f64).sqrt();
+        assert!((f - p).abs() < 5.0 * sd, "side {side}: {f} vs {p}");
+    }
+    // Without a hit (radiosity, weights) the amount is the texture's mean, 0.55.
+    let a = w.diffuse_albedo(2);
+    assert!((a.g - 0.8 * 0.45).abs() < 1e-3, "{a:?}");
+}
+
+#[test]
 fn mix_amounts_zero_and_one_pick_one_material() {
     for (amount, specular) in [(0.0, false), (1.0, true)] {
         let w = world(&format!(

@@ -167,6 +167,7 @@ fn cornell_room(scene: &str) -> Vec<ShapeDesc> {
     light.area_light = Some(AreaLightDesc {
         l: LIGHT_LE,
         two_sided: false,
+        image: None,
     });
     vec![
         // floor
@@ -350,6 +351,7 @@ pub fn furnace() -> SceneDesc {
     s.area_light = Some(AreaLightDesc {
         l: Rgb::WHITE,
         two_sided: false,
+        image: None,
     });
     let camera = right_handed_camera(Vec3::ZERO, Vec3::Z, Vec3::Y, 60.0, name);
     let materials = vec![MaterialDesc::Diffuse {

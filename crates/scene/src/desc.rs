@@ -214,11 +214,12 @@ pub enum MaterialDesc {
         transmittance: Rgb,
     },
     /// `"mix"`: at each hit one of two materials, the second with probability `amount`
-    /// (pbrt-v4's convention), chosen by a hash of the hit so that it is the same every
-    /// time the same point is seen from the same direction.
+    /// (pbrt-v4's convention; a float texture is evaluated at the hit), chosen by a
+    /// hash of the hit so that it is the same every time the same point is seen from
+    /// the same direction.
     Mix {
         materials: [MaterialId; 2],
-        amount: f32,
+        amount: FloatParam,
     },
     /// pbrt-v4's `coateddiffuse`: a dielectric coat over a Lambertian base of
     /// `reflectance`.
@@ -269,10 +270,24 @@ pub enum ConductorDesc {
 /// A diffuse area light attached to a shape (`AreaLightSource "diffuse"`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct AreaLightDesc {
-    /// Emitted radiance, `scale` (and `power`) already applied.
+    /// Emitted radiance, `scale` (and `power`) already applied; with `image`, the
+    /// factor the image's radiance is multiplied by.
     pub l: Rgb,
     /// Emits on both sides; otherwise only on the side of the surface normal.
     pub two_sided: bool,
+    /// `filename`: the radiance varies over the surface as this picture does.
+    pub image: Option<AreaLightImage>,
+}
+
+/// The picture of an area light given by `filename` (pbrt-v4's `DiffuseAreaLight`):
+/// the radiance at a surface point is the image bilinearly interpolated at the
+/// point's (u, 1 − v), clamped at the borders, times [`AreaLightDesc::l`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct AreaLightImage {
+    pub image: LightImage,
+    /// `power` was given: `l` was computed for an image of mean luminance 1 and is
+    /// divided by the image's mean luminance once the image is read.
+    pub per_unit_mean: bool,
 }
 
 /// Shape geometry in object space.

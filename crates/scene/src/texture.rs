@@ -221,9 +221,10 @@ pub enum TexturedMaterialDesc {
     Diffuse { reflectance: SpectrumParam },
     /// Dielectric of index `eta` with textured roughness.
     RoughDielectric { eta: f32, roughness: RoughnessDesc },
-    /// Conductor with textured roughness.
+    /// Conductor with textured roughness or textured `reflectance` / `eta` / `k`
+    /// (a zero roughness is the smooth conductor).
     RoughConductor {
-        conductor: ConductorDesc,
+        conductor: TexturedConductorDesc,
         roughness: RoughnessDesc,
     },
     /// `diffusetransmission` with a textured `reflectance` or `transmittance`, each
@@ -233,11 +234,106 @@ pub enum TexturedMaterialDesc {
         transmittance: SpectrumParam,
         scale: f32,
     },
-    /// `coateddiffuse` with a textured base `reflectance` (clamped to [0, 1]).
+    /// `coateddiffuse` with a textured base `reflectance` (clamped to [0, 1]) or
+    /// textured coat parameters.
     CoatedDiffuse {
         reflectance: SpectrumParam,
-        coat: CoatDesc,
+        coat: TexturedCoatDesc,
     },
+    /// `coatedconductor` with a textured conductor, conductor roughness or coat.
+    CoatedConductor {
+        conductor: TexturedConductorDesc,
+        roughness: RoughnessDesc,
+        coat: TexturedCoatDesc,
+    },
+}
+
+/// A conductor's colour (`reflectance`) or complex index (`eta`, `k`), each possibly
+/// textured.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TexturedConductorDesc {
+    Reflectance(SpectrumParam),
+    EtaK {
+        eta: SpectrumParam,
+        k: SpectrumParam,
+    },
+}
+
+impl TexturedConductorDesc {
+    /// The conductor once its parameters have values.
+    pub fn concrete(&self, spectrum: impl Fn(SpectrumParam) -> Rgb) -> ConductorDesc {
+        match *self {
+            TexturedConductorDesc::Reflectance(r) => ConductorDesc::Reflectance(spectrum(r)),
+            TexturedConductorDesc::EtaK { eta, k } => ConductorDesc::EtaK {
+                eta: spectrum(eta),
+                k: spectrum(k),
+            },
+        }
+    }
+}
+
+/// The coat and slab of a layered material as written: pbrt-v4 lets the coat's
+/// roughness, the slab's `thickness`, `albedo` and `g` be textures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TexturedCoatDesc {
+    pub eta: f32,
+    pub roughness: RoughnessDesc,
+    pub thickness: FloatParam,
+    pub albedo: SpectrumParam,
+    pub g: FloatParam,
+    pub max_depth: u32,
+    pub samples: u32,
+}
+
+/// The largest |g| a textured asymmetry is clamped to (Henyey–Greenstein needs |g| < 1).
+const MAX_ABS_G: f32 = 0.999;
+
+impl TexturedCoatDesc {
+    /// The coat once its parameters have values: albedo clamped to [0, 1], `g` into
+    /// (-1, 1), the thickness kept positive (constant values were checked when read).
+    pub fn concrete(
+        &self,
+        float: impl Fn(FloatParam) -> f32,
+        spectrum: impl Fn(SpectrumParam) -> Rgb,
+    ) -> CoatDesc {
+        let (alpha_u, alpha_v) = self
+            .roughness
+            .alphas(float(self.roughness.u), float(self.roughness.v));
+        let thickness = float(self.thickness);
+        let g = float(self.g);
+        CoatDesc {
+            eta: self.eta,
+            alpha_u,
+            alpha_v,
+            thickness: if thickness > f32::MIN_POSITIVE {
+                thickness
+            } else {
+                f32::MIN_POSITIVE
+            },
+            albedo: spectrum(self.albedo).map(|c| c.clamp(0.0, 1.0)),
+            g: if g.is_nan() {
+                0.0
+            } else {
+                g.clamp(-MAX_ABS_G, MAX_ABS_G)
+            },
+            max_depth: self.max_depth,
+            samples: self.samples,
+        }
+    }
+
+    /// The coat when no parameter is a texture.
+    pub fn constant(&self) -> Option<CoatDesc> {
+        let textured = [self.roughness.u, self.roughness.v, self.thickness, self.g]
+            .iter()
+            .any(|p| p.constant().is_none())
+            || self.albedo.constant().is_none();
+        (!textured).then(|| {
+            self.concrete(
+                |p| p.constant().unwrap_or(0.0),
+                |p| p.constant().unwrap_or(Rgb::BLACK),
+            )
+        })
+    }
 }
 
 /// How a material tilts the shading normal before its BSDF is evaluated.

@@ -180,6 +180,38 @@ const CASES: &[(&str, &str, u32, u32, &[&str])] = &[
         5,
         &["2 normals for 3 vertices"],
     ),
+    (
+        "area_light_image_and_l.pbrt",
+        "area_light_image_and_l.pbrt",
+        2,
+        56,
+        &["either \"L\" or \"filename\""],
+    ),
+    (
+        "mix_amount_wrong_texture_type.pbrt",
+        "mix_amount_wrong_texture_type.pbrt",
+        5,
+        47,
+        &[
+            "\"amount\"",
+            "needs a float texture",
+            "\"tint\" is a spectrum texture",
+        ],
+    ),
+    (
+        "coat_thickness_texture_undefined.pbrt",
+        "coat_thickness_texture_undefined.pbrt",
+        2,
+        26,
+        &["\"thickness\"", "undefined float texture \"nowhere\""],
+    ),
+    (
+        "conductor_eta_wrong_texture_type.pbrt",
+        "conductor_eta_wrong_texture_type.pbrt",
+        3,
+        28,
+        &["needs a spectrum texture", "\"w\" is a float texture"],
+    ),
 ];
 
 #[test]

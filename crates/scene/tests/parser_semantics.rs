@@ -291,11 +291,11 @@ fn thin_dielectric_diffuse_transmission_and_mix_follow_pbrt_v4() {
             MaterialDesc::Dielectric { eta: 1.5 },
             MaterialDesc::Mix {
                 materials: [3, 4],
-                amount: 0.5,
+                amount: TexturedParam::Constant(0.5),
             },
             MaterialDesc::Mix {
                 materials: [5, 4],
-                amount: 0.3,
+                amount: TexturedParam::Constant(0.3),
             },
         ]
     );

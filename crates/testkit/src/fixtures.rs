@@ -79,6 +79,7 @@ pub fn glowing_sphere(le: Rgb) -> SceneDesc {
     desc.shapes[0].area_light = Some(AreaLightDesc {
         l: le,
         two_sided: false,
+        image: None,
     });
     desc
 }

@@ -9,20 +9,28 @@
 //! the amount-weighted albedo of its two materials, and glass and metals by zero (their
 //! patches absorb; the display follows camera rays through them by their BSDF). A
 //! textured diffuse reflectance is reduced to its mean over the (u, v) square (a 16 × 16
-//! grid of point lookups), one value for all patches of the shape. Patches are one-sided:
+//! grid of point lookups), one value for all patches of the shape; so is an area light's
+//! image (its mean, with a warning). A shape with a constant alpha of 0 is left out;
+//! other alpha cut-outs are solved as opaque (with a warning). Patches are one-sided:
 //! the front is the side the shape's
 //! normal points to (pbrt's rules: winding, `ReverseOrientation`, handedness of the
 //! transform, shading normals), which is also the side a one-sided light emits on.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
 
 use glam::{DMat4, DVec3, Vec3};
 
 use super::face_mesh::{FaceMesh, Subdivision};
 use super::patch::PatchSet;
 use crate::settings::{DEFAULT_PATCH_COUNT, RadiositySettings, SolverKind};
-use radiant_render::texture::TextureSet;
+use radiant_math::color::Rgb;
+use radiant_render::light::EmissionImage;
+use radiant_render::texture::{TextureSet, concrete_material};
+use radiant_render::world::{image_emission_factor, read_emission_image};
 use radiant_scene::{
-    Geometry, MaterialDesc, SceneDesc, SceneError, ShapeDesc, TexturedMaterialDesc, Warning,
-    sphere_z_range,
+    AreaLightDesc, FileLoc, Geometry, MaterialDesc, SceneDesc, SceneError, ShapeDesc,
+    TexturedMaterialDesc, TexturedParam, Warning, sphere_z_range,
 };
 
 /// What every patch of one input face carries.
@@ -39,6 +47,33 @@ pub struct SurfaceTag {
 
 /// Point lookups per axis over the (u, v) square for a textured reflectance's mean.
 const TEXTURE_AVERAGE_GRID: u32 = 16;
+
+/// The radiance an area light's patches emit: `l`, or for a light with an image its
+/// mean over the image (one value per shape, as for textured reflectances; reported
+/// once per image). Images are read once per file.
+fn area_light_mean(
+    a: &AreaLightDesc,
+    loc: &FileLoc,
+    images: &mut HashMap<PathBuf, EmissionImage>,
+    warnings: &mut Vec<Warning>,
+) -> Result<Rgb, SceneError> {
+    let Some(picture) = &a.image else {
+        return Ok(a.l);
+    };
+    let path = &picture.image.path;
+    if !images.contains_key(path) {
+        images.insert(path.clone(), read_emission_image(&picture.image)?);
+        warnings.push(Warning {
+            loc: loc.clone(),
+            message: format!(
+                "radiosity: the area light's image '{}' is emitted as its mean radiance over each shape",
+                path.display()
+            ),
+        });
+    }
+    let image = &images[path];
+    Ok(image_emission_factor(a, image).unwrap_or(a.l) * image.mean())
+}
 
 /// The diffuse albedo radiosity gives each material, per band in [0, 1]: a mix's is
 /// the amount-weighted mean of its two materials' (memoised, so shared sub-mixes cost
@@ -63,30 +98,23 @@ fn diffuse_albedos(materials: &[MaterialDesc], textures: &TextureSet) -> Vec<[f6
             Some(d @ MaterialDesc::CoatedDiffuse { .. }) => {
                 clamp(radiant_render::material::Material::from_desc(d).diffuse_albedo())
             }
-            // One reflectance per shape: the texture's mean over (u, v).
-            Some(MaterialDesc::Textured(TexturedMaterialDesc::Diffuse { reflectance })) => {
-                clamp(textures.uv_average(*reflectance, TEXTURE_AVERAGE_GRID))
-            }
-            Some(MaterialDesc::Textured(TexturedMaterialDesc::DiffuseTransmission {
-                reflectance,
-                scale,
-                ..
-            })) => clamp(textures.uv_average(*reflectance, TEXTURE_AVERAGE_GRID) * *scale),
-            Some(MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse {
-                reflectance,
-                coat,
-            })) => {
-                let d = MaterialDesc::CoatedDiffuse {
-                    reflectance: textures.uv_average(*reflectance, TEXTURE_AVERAGE_GRID),
-                    coat: *coat,
-                };
-                clamp(radiant_render::material::Material::from_desc(&d).diffuse_albedo())
-            }
+            // One reflectance per shape: the material with each texture at its mean
+            // over (u, v).
+            Some(MaterialDesc::Textured(t)) => clamp(
+                concrete_material(
+                    t,
+                    |p| textures.uv_average_float(p, TEXTURE_AVERAGE_GRID),
+                    |p| textures.uv_average(p, TEXTURE_AVERAGE_GRID),
+                )
+                .diffuse_albedo(),
+            ),
             Some(MaterialDesc::Mix {
                 materials: m,
                 amount,
             }) if depth < 64 => {
-                let t = (*amount as f64).clamp(0.0, 1.0);
+                // A textured amount by its mean over (u, v), as textured reflectances.
+                let t = (textures.uv_average_float(*amount, TEXTURE_AVERAGE_GRID) as f64)
+                    .clamp(0.0, 1.0);
                 let x = albedo(materials, textures, memo, m[0], depth + 1);
                 let y = albedo(materials, textures, memo, m[1], depth + 1);
                 [0, 1, 2].map(|k| (1.0 - t) * x[k] + t * y[k])
@@ -119,6 +147,7 @@ fn material_type(m: &MaterialDesc) -> &'static str {
         MaterialDesc::Textured(TexturedMaterialDesc::RoughDielectric { .. }) => "dielectric",
         MaterialDesc::Textured(TexturedMaterialDesc::RoughConductor { .. }) => "conductor",
         MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse { .. }) => "coateddiffuse",
+        MaterialDesc::Textured(TexturedMaterialDesc::CoatedConductor { .. }) => "coatedconductor",
         MaterialDesc::Textured(TexturedMaterialDesc::DiffuseTransmission { .. }) => {
             "diffusetransmission"
         }
@@ -168,6 +197,7 @@ impl RadiosityScene {
         let mut approximated = vec![false; desc.materials.len()];
         let albedos = diffuse_albedos(&desc.materials, &textures);
         let mut tags = Vec::new();
+        let mut image_means = HashMap::new();
         let mut shape_tags = Vec::with_capacity(shapes.len());
         for (k, (shape, _)) in shapes.iter().enumerate() {
             let Some(material) = desc.materials.get(shape.material as usize) else {
@@ -195,14 +225,25 @@ impl RadiosityScene {
                     ),
                 });
             }
-            let emission = shape.area_light.as_ref().map_or([0.0; 3], |a| {
-                a.l.to_array()
-                    .map(|l| std::f64::consts::PI * l.max(0.0) as f64)
-            });
+            let emission = match &shape.area_light {
+                None => [0.0; 3],
+                Some(a) => area_light_mean(a, &shape.loc, &mut image_means, &mut warnings)?
+                    .to_array()
+                    .map(|l| std::f64::consts::PI * l.max(0.0) as f64),
+            };
             let is_interface = matches!(material, MaterialDesc::Interface);
-            if is_interface && emission == [0.0; 3] {
+            // A shape cut out everywhere is not there at all (pbrt-v4 masks its
+            // emission too); partial cut-outs are solved as opaque patches.
+            let invisible = matches!(shape.alpha, Some(TexturedParam::Constant(a)) if a <= 0.0);
+            if invisible || (is_interface && emission == [0.0; 3]) {
                 shape_tags.push(None);
                 continue;
+            }
+            if shape.alpha.is_some() {
+                warnings.push(Warning {
+                    loc: shape.loc.clone(),
+                    message: "radiosity: the shape's alpha cut-out is not honoured by the solve; its patches are opaque".into(),
+                });
             }
             tags.push(SurfaceTag {
                 material: shape.material,

@@ -34,6 +34,7 @@ fn quads(list: &[[Vec3; 4]], material: u32, light: Option<Rgb>) -> ShapeDesc {
         area_light: light.map(|l| AreaLightDesc {
             l,
             two_sided: false,
+            image: None,
         }),
         ..ShapeDesc::quads(
             list,

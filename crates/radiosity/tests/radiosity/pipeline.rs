@@ -302,6 +302,7 @@ fn curved_bilinear_patches_are_meshed_on_their_surface() {
             area_light: Some(AreaLightDesc {
                 l: radiant_math::color::Rgb::splat(1.0),
                 two_sided: false,
+                image: None,
             }),
             ..ShapeDesc::quads(
                 &[[
@@ -394,4 +395,98 @@ fn non_diffuse_materials_use_their_diffuse_albedo_with_one_warning_each() {
     assert!(close(reflectance(3), [0.3, 0.4, 0.5]));
     assert!(close(reflectance(4), [0.0; 3]));
     assert!(close(reflectance(5), [0.6; 3]), "{:?}", reflectance(5));
+}
+
+/// Textured inputs become one value per shape: an area light's image emits its mean
+/// (times `scale`; with `power`, normalised by the image's mean luminance as the
+/// renderer does), with one warning naming the file, and a textured mix amount counts
+/// by its mean over (u, v).
+#[test]
+fn image_emission_and_textured_mix_amounts_enter_by_their_means() {
+    let dir = std::env::temp_dir().join(format!("radiant-radiosity-images-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let pixels: Vec<radiant_math::color::Rgb> = (0..4)
+        .map(|k| radiant_math::color::Rgb::new(k as f32, 1.0, 0.5))
+        .collect();
+    let img = radiant_image::Image {
+        width: 2,
+        height: 2,
+        pixels,
+    };
+    radiant_image::pfm::write_pfm(dir.join("glow.pfm"), &img).unwrap();
+    let quad = |z: f32| {
+        format!(
+            "Shape \"trianglemesh\" \"point3 P\" [ 0 0 {z}  1 0 {z}  1 1 {z}  0 1 {z} ] \
+             \"point2 uv\" [ 0 0 1 0 1 1 0 1 ] \"integer indices\" [ 0 1 2  0 2 3 ]\n"
+        )
+    };
+    let text = format!(
+        "WorldBegin\n\
+         AttributeBegin\nAreaLightSource \"diffuse\" \"string filename\" \"glow.pfm\" \"float scale\" 2\n{}AttributeEnd\n\
+         AttributeBegin\nAreaLightSource \"diffuse\" \"string filename\" \"glow.pfm\" \"float power\" 3\n{}AttributeEnd\n\
+         Texture \"amt\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 1 \
+           \"float tex1\" 0 \"float tex2\" 1\n\
+         MakeNamedMaterial \"white\" \"string type\" \"diffuse\" \"rgb reflectance\" [ 0.8 0.8 0.8 ]\n\
+         MakeNamedMaterial \"black\" \"string type\" \"diffuse\" \"rgb reflectance\" [ 0 0 0 ]\n\
+         Material \"mix\" \"string materials\" [ \"white\" \"black\" ] \"texture amount\" \"amt\"\n{}",
+        quad(0.0),
+        quad(1.0),
+        quad(2.0),
+    );
+    let desc = radiant_scene::parse_str(&text, "t.pbrt", &dir).unwrap();
+    let scene = RadiosityScene::from_desc(&desc, &settings_with_area(1.0)).unwrap();
+    let image_warnings = scene
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("glow.pfm"))
+        .count();
+    assert_eq!(image_warnings, 1, "{:#?}", scene.warnings);
+    let tag = |shape: u32| scene.tags.iter().find(|t| t.shape == shape).unwrap();
+    let pi = std::f64::consts::PI;
+    // Mean texel (1.5, 1, 0.5), times the scale, as exitance π L.
+    let e0 = tag(0).emission;
+    for (k, want) in [3.0, 2.0, 1.0].into_iter().enumerate() {
+        assert!((e0[k] - pi * want).abs() < 1e-5, "{e0:?}");
+    }
+    // power 3 over a one-sided unit square: mean luminance π L̄ A = 3.
+    let e1 = tag(1).emission;
+    let lum = 0.2126 * e1[0] + 0.7152 * e1[1] + 0.0722 * e1[2];
+    assert!((lum - 3.0).abs() < 1e-4, "{e1:?}");
+    // Half black by the amount's mean: 0.4.
+    let r = tag(2).reflectance;
+    assert!((r[1] - 0.4).abs() < 1e-6, "{r:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A shape cut out everywhere (constant alpha 0) is left out of the solve; one with a
+/// partial cut-out is solved as opaque and reported.
+#[test]
+fn alpha_cut_outs_are_left_out_or_reported() {
+    let quad = |z: f32, alpha: &str| {
+        format!(
+            "Shape \"trianglemesh\" \"point3 P\" [ 0 0 {z}  1 0 {z}  1 1 {z}  0 1 {z} ] \
+             \"integer indices\" [ 0 1 2  0 2 3 ] {alpha}\n"
+        )
+    };
+    let text = format!(
+        "WorldBegin\n\
+         Texture \"holes\" \"float\" \"checkerboard\" \"float tex1\" 0 \"float tex2\" 1\n\
+         AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [ 1 1 1 ]\n{}AttributeEnd\n\
+         {}{}{}",
+        quad(0.0, ""),
+        quad(1.0, "\"float alpha\" 0"),
+        quad(2.0, "\"texture alpha\" \"holes\""),
+        quad(3.0, "\"float alpha\" 0.5"),
+    );
+    let desc = radiant_scene::parse_str(&text, "t.pbrt", std::path::Path::new(".")).unwrap();
+    let scene = RadiosityScene::from_desc(&desc, &settings_with_area(1.0)).unwrap();
+    let shapes: Vec<u32> = scene.tags.iter().map(|t| t.shape).collect();
+    assert!(!shapes.contains(&1), "{shapes:?}");
+    assert!(shapes.contains(&0) && shapes.contains(&2) && shapes.contains(&3));
+    let reported = scene
+        .warnings
+        .iter()
+        .filter(|w| w.message.contains("alpha cut-out"))
+        .count();
+    assert_eq!(reported, 2, "{:#?}", scene.warnings);
 }

@@ -100,6 +100,30 @@ impl Disk {
         })
     }
 
+    /// ∂p/∂v at a point of the disk: v = (radius − r) / (radius − inner radius)
+    /// falls outwards, so ∂p/∂v = −(radius − inner radius) (x, y, 0) / r.
+    pub fn dpdv(&self, p: Vec3) -> Vec3 {
+        let r = (p.x * p.x + p.y * p.y).sqrt();
+        if !(r > 0.0) {
+            return Vec3::ZERO;
+        }
+        -(self.radius - self.inner_radius) * Vec3::new(p.x, p.y, 0.0) / r
+    }
+
+    /// Surface parameters of a point on the disk: (phi / phi_max, (radius − r) /
+    /// (radius − inner radius)), as hits report them.
+    pub fn uv(&self, p: Vec3) -> Vec2 {
+        let mut phi = p.y.atan2(p.x);
+        if phi < 0.0 {
+            phi += 2.0 * PI;
+        }
+        let r = (p.x * p.x + p.y * p.y).sqrt();
+        Vec2::new(
+            (phi / self.phi_max).min(1.0),
+            (self.radius - r) / (self.radius - self.inner_radius),
+        )
+    }
+
     /// Uniform sampling by area (pdf = 1 / area). The full disk uses the concentric map
     /// (Shirley & Chiu 1997) for low distortion; annuli and sectors use r² uniform in
     /// [inner², radius²] and phi uniform in [0, phi_max], which is also area-uniform.
@@ -129,6 +153,20 @@ impl Disk {
 mod tests {
     use super::*;
     use radiant_math::hash::Pcg32;
+
+    #[test]
+    fn dpdv_moves_along_v_at_the_rate_of_the_parameterisation() {
+        let d = Disk::new(0.5, 2.0, 0.4, 250.0).unwrap();
+        let mut rng = Pcg32::new(6, 1);
+        for _ in 0..200 {
+            let p = d.sample_area(Vec2::new(rng.uniform(), rng.uniform())).p;
+            let uv = d.uv(p);
+            let h = 1e-3;
+            let duv = d.uv(p + h * d.dpdv(p)) - uv;
+            assert!((duv.y - h).abs() < 1e-2 * h, "dv {} for step {h}", duv.y);
+            assert!(duv.x.abs() < 1e-6, "du {}", duv.x);
+        }
+    }
 
     #[test]
     fn hits_match_analytic_plane_and_annulus() {

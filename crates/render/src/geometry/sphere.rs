@@ -156,6 +156,21 @@ impl Sphere {
         Vec2::new(phi / self.phi_max, (theta(p.z) - th_lo) / (th_hi - th_lo))
     }
 
+    /// ∂p/∂v at a surface point (v runs along the polar angle θ from θ(z_min) to
+    /// θ(z_max)): (θ_max − θ_min) (z cos φ, z sin φ, −r sin θ); zero at the poles,
+    /// where φ is undefined.
+    pub fn dpdv(&self, p: Vec3) -> Vec3 {
+        let r = self.radius;
+        let theta = |z: f32| (z / r).clamp(-1.0, 1.0).acos();
+        let span = theta(self.z_max) - theta(self.z_min);
+        let rho = (p.x * p.x + p.y * p.y).sqrt();
+        if !(rho > 0.0) {
+            return Vec3::ZERO;
+        }
+        let (cos_phi, sin_phi) = (p.x / rho, p.y / rho);
+        span * Vec3::new(p.z * cos_phi, p.z * sin_phi, -rho)
+    }
+
     /// Unit outward normal at a surface point.
     pub fn normal(&self, p: Vec3) -> Vec3 {
         p / self.radius
@@ -269,6 +284,25 @@ mod tests {
 
     fn u2(rng: &mut Pcg32) -> Vec2 {
         Vec2::new(rng.uniform(), rng.uniform())
+    }
+
+    #[test]
+    fn dpdv_moves_along_v_at_the_rate_of_the_parameterisation() {
+        let s = Sphere::partial(2.0, -1.2, 1.5, 300.0).unwrap();
+        let mut rng = Pcg32::new(5, 1);
+        for _ in 0..200 {
+            let p = s.sample_area(u2(&mut rng)).p;
+            let uv = s.uv(p);
+            if !(0.05..0.95).contains(&uv.y) {
+                continue;
+            }
+            // A small step along ∂p/∂v, projected back onto the sphere.
+            let h = 1e-3;
+            let q = (p + h * s.dpdv(p)).normalize() * s.radius;
+            let duv = s.uv(q) - uv;
+            assert!((duv.y - h).abs() < 2e-2 * h, "dv {} for step {h}", duv.y);
+            assert!(duv.x.abs() < 1e-2 * h, "du {}", duv.x);
+        }
     }
 
     #[test]

@@ -158,7 +158,7 @@ pub fn surface_emission(world: &World, hit: &SurfaceHit, wo: Vec3) -> Rgb {
         return Rgb::BLACK;
     }
     match &world.lights[hit.light as usize] {
-        Light::Area(a) => a.radiance(hit.ng, wo),
+        Light::Area(a) => a.radiance(hit.ng, hit.uv, wo),
         _ => Rgb::BLACK,
     }
 }

@@ -135,7 +135,7 @@ pub fn radiance(
     let mut travelled = 0.0f32;
     loop {
         rays += 1;
-        let Some(mut hit) = world.intersect(&ray, f32::INFINITY) else {
+        let Some(hit) = world.intersect_with_footprint(&ray, f32::INFINITY, travelled) else {
             for (i, light) in world.lights.iter().enumerate() {
                 let le = light.environment(ray.d);
                 if le.is_black() {
@@ -153,13 +153,12 @@ pub fn radiance(
             break;
         };
         travelled += hit.t * ray.d.length();
-        world.add_footprint(&mut hit, ray.d, travelled);
         let wo_world = -ray.d.normalize();
         if hit.light != NO_LIGHT {
             let Light::Area(area) = &world.lights[hit.light as usize] else {
                 unreachable!("primitives only carry area lights")
             };
-            let le = area.radiance(hit.ng, wo_world);
+            let le = area.radiance(hit.ng, hit.uv, wo_world);
             if !le.is_black() {
                 let w = if specular_bounce {
                     1.0

@@ -5,9 +5,15 @@
 //! choice among them would break the 2D stratification of the point on the emitter: on
 //! the Cornell box's quad light that costs 3.2× the direct-light variance of sampling
 //! the quad as one patch.
+//!
+//! With an image (`filename`) the radiance at a point is `l` times the image at the
+//! point's (u, v), the same (u, v) a ray hitting the point sees: samples carry them.
+
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
+use super::emission_image::EmissionImage;
 use super::{LightHit, LightLeSample, LightLiSample, LightPoint, LightSampleContext};
 use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
@@ -71,12 +77,16 @@ pub struct EmittingMesh {
     pub by_area: Distribution1D,
     /// Total area.
     pub area: f32,
+    /// Surface (u, v) at the vertices of each triangle, for a light with an image;
+    /// empty otherwise.
+    pub uvs: Vec<[Vec2; 3]>,
 }
 
 impl EmittingMesh {
     /// The mesh of `triangles` with front normals `normals`; every triangle must have a
-    /// positive area.
-    pub fn new(triangles: Vec<[Vec3; 3]>, normals: Vec<Vec3>) -> EmittingMesh {
+    /// positive area. `uvs` is empty, or the (u, v) of each triangle's vertices.
+    pub fn new(triangles: Vec<[Vec3; 3]>, normals: Vec<Vec3>, uvs: Vec<[Vec2; 3]>) -> EmittingMesh {
+        assert!(uvs.is_empty() || uvs.len() == triangles.len());
         let areas: Vec<f32> = triangles
             .iter()
             .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
@@ -87,6 +97,7 @@ impl EmittingMesh {
             normals,
             by_area: Distribution1D::new(&areas),
             area,
+            uvs,
         }
     }
 }
@@ -109,8 +120,19 @@ pub fn parallelogram_of(a: [Vec3; 3], b: [Vec3; 3]) -> Option<(Vec3, Vec3, Vec3)
 #[derive(Clone, Debug)]
 pub struct AreaLight {
     pub shape: LightShape,
+    /// The radiance; with `image`, the factor the image is multiplied by.
     pub l: Rgb,
     pub two_sided: bool,
+    /// Emission varying over the surface (pbrt-v4's `filename`). Triangles of a light
+    /// with an image are always a [`LightShape::Mesh`] with its `uvs`.
+    pub image: Option<Arc<EmissionImage>>,
+}
+
+/// A point sampled on the light with its surface (u, v) (zero when the light has no
+/// image, which is the only reader).
+struct EmitterSample {
+    area: AreaSample,
+    uv: Vec2,
 }
 
 impl AreaLight {
@@ -130,24 +152,42 @@ impl AreaLight {
 
     pub fn power(&self) -> Rgb {
         let sides = if self.two_sided { 2.0 } else { 1.0 };
-        self.l * (PI * self.area() * sides)
+        self.mean_radiance() * (PI * self.area() * sides)
     }
 
-    /// Radiance leaving a point with front normal `n` in direction `w`.
-    pub fn radiance(&self, n: Vec3, w: Vec3) -> Rgb {
-        if self.two_sided || n.dot(w) > 0.0 {
-            self.l
-        } else {
-            Rgb::BLACK
+    /// The radiance averaged over the surface's (u, v): `l`, or `l` times the image's
+    /// mean (exact for the uniform parameterisations of triangles, quads and disks
+    /// with the default uvs; a fair weight for light selection otherwise).
+    pub fn mean_radiance(&self) -> Rgb {
+        match &self.image {
+            None => self.l,
+            Some(img) => self.l * img.mean(),
         }
     }
 
-    /// A point on the light sampled uniformly by render-space area.
-    fn sample_area(&self, u: Vec2) -> Option<AreaSample> {
-        match &self.shape {
+    /// Radiance leaving a point with front normal `n` and surface parameters `uv` in
+    /// direction `w`.
+    pub fn radiance(&self, n: Vec3, uv: Vec2, w: Vec3) -> Rgb {
+        if !(self.two_sided || n.dot(w) > 0.0) {
+            return Rgb::BLACK;
+        }
+        match &self.image {
+            None => self.l,
+            Some(img) => self.l * img.lookup(uv),
+        }
+    }
+
+    /// A point on the light sampled uniformly by render-space area, with its (u, v).
+    fn sample_area(&self, u: Vec2) -> Option<EmitterSample> {
+        let with_uv = self.image.is_some();
+        let plain = |area: AreaSample| EmitterSample {
+            area,
+            uv: Vec2::ZERO,
+        };
+        Some(match &self.shape {
             LightShape::Triangle { p, n, area } => {
                 let s = sample_triangle(p[0], p[1], p[2], u)?;
-                Some(AreaSample {
+                plain(AreaSample {
                     p: s.p,
                     p_error: s.p_error,
                     n: *n,
@@ -158,7 +198,7 @@ impl AreaLight {
                 let q = *p + *e1 * u.x + *e2 * u.y;
                 // Two products and two sums per coordinate.
                 let p_error = gamma(4) * (p.abs() + (*e1 * u.x).abs() + (*e2 * u.y).abs());
-                Some(AreaSample {
+                plain(AreaSample {
                     p: q,
                     p_error,
                     n: *n,
@@ -168,13 +208,25 @@ impl AreaLight {
             LightShape::Mesh(m) => {
                 let (i, _, rest) = m.by_area.sample(u.x);
                 let t = m.triangles[i];
-                let s = sample_triangle(t[0], t[1], t[2], Vec2::new(rest, u.y))?;
-                Some(AreaSample {
-                    p: s.p,
-                    p_error: s.p_error,
-                    n: m.normals[i],
-                    pdf: 1.0 / m.area,
-                })
+                let ut = Vec2::new(rest, u.y);
+                let s = sample_triangle(t[0], t[1], t[2], ut)?;
+                let uv = match m.uvs.get(i) {
+                    Some(tuv) if with_uv => {
+                        // The barycentrics `sample_triangle` placed the point at.
+                        let b = sampling::uniform_triangle(ut);
+                        tuv[0] * b[0] + tuv[1] * b[1] + tuv[2] * b[2]
+                    }
+                    _ => Vec2::ZERO,
+                };
+                EmitterSample {
+                    area: AreaSample {
+                        p: s.p,
+                        p_error: s.p_error,
+                        n: m.normals[i],
+                        pdf: 1.0 / m.area,
+                    },
+                    uv,
+                }
             }
             LightShape::Sphere {
                 sphere,
@@ -182,32 +234,40 @@ impl AreaLight {
                 reverse,
             } => {
                 let s = sphere.sample_area(u);
-                Some(to_render(
-                    s,
-                    render_from_object,
-                    *reverse,
-                    similarity_scale2(render_from_object),
-                ))
+                EmitterSample {
+                    uv: if with_uv { sphere.uv(s.p) } else { Vec2::ZERO },
+                    area: to_render(
+                        s,
+                        render_from_object,
+                        *reverse,
+                        similarity_scale2(render_from_object),
+                    ),
+                }
             }
             LightShape::Disk {
                 disk,
                 render_from_object,
                 reverse,
                 scale2,
-            } => Some(to_render(
-                disk.sample_area(u),
-                render_from_object,
-                *reverse,
-                *scale2,
-            )),
+            } => {
+                let s = disk.sample_area(u);
+                EmitterSample {
+                    uv: if with_uv { disk.uv(s.p) } else { Vec2::ZERO },
+                    area: to_render(s, render_from_object, *reverse, *scale2),
+                }
+            }
             LightShape::Bilinear { patch, orientation } => {
                 let s = patch.sample_area(u)?;
-                Some(AreaSample {
-                    n: s.n * *orientation,
-                    ..s
-                })
+                EmitterSample {
+                    // The patch is sampled in its own (u, v).
+                    uv: u,
+                    area: AreaSample {
+                        n: s.n * *orientation,
+                        ..s
+                    },
+                }
             }
-        }
+        })
     }
 
     /// A point on the light seen from `ctx`: spheres sample the cone they subtend (far
@@ -215,7 +275,7 @@ impl AreaLight {
     /// solid angle.
     pub fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightLiSample> {
         let p = ctx.p;
-        let (p_light, pdf) = match &self.shape {
+        let (p_light, pdf, uv) = match &self.shape {
             LightShape::Sphere {
                 sphere,
                 render_from_object,
@@ -228,13 +288,19 @@ impl AreaLight {
                     n = -n;
                 }
                 let (q, q_error) = transform_point_with_error(render_from_object, s.p, s.p_error);
-                (LightPoint::new(q, q_error, n), s.pdf)
+                let uv = if self.image.is_some() {
+                    sphere.uv(s.p)
+                } else {
+                    Vec2::ZERO
+                };
+                (LightPoint::new(q, q_error, n), s.pdf, uv)
             }
             _ => {
-                let s = self.sample_area(u)?;
+                let EmitterSample { area: s, uv } = self.sample_area(u)?;
                 (
                     LightPoint::new(s.p, s.p_error, s.n),
                     area_pdf_to_solid_angle(s.pdf, p, s.p, s.n),
+                    uv,
                 )
             }
         };
@@ -243,7 +309,7 @@ impl AreaLight {
             return None;
         }
         let wi = (q - p).normalize_or_zero();
-        let li = self.radiance(n, -wi);
+        let li = self.radiance(n, uv, -wi);
         if li.is_black() || wi == Vec3::ZERO {
             return None;
         }
@@ -282,7 +348,11 @@ impl AreaLight {
     /// probability 1/2 when both emit. Its power is L π / pdf_pos per side — the
     /// light's whole power when the position is uniform.
     pub fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<LightLeSample> {
-        let s = self.sample_area(u_pos)?;
+        let EmitterSample { area: s, uv } = self.sample_area(u_pos)?;
+        let le = match &self.image {
+            None => self.l,
+            Some(img) => self.l * img.lookup(uv),
+        };
         let (mut u, mut n) = (u_dir, s.n);
         let mut sides = 1.0;
         if self.two_sided {
@@ -303,8 +373,8 @@ impl AreaLight {
             n,
             pdf_pos: s.pdf,
             pdf_dir: sampling::cosine_hemisphere_pdf(local.z) / sides,
-            le: self.l,
-            power: self.l * (PI * sides / s.pdf),
+            le,
+            power: le * (PI * sides / s.pdf),
         })
     }
 }

@@ -10,6 +10,7 @@
 //! leaving the light with the flux it carries (photon tracing).
 
 mod area;
+mod emission_image;
 mod environment;
 mod image_point;
 mod infinite;
@@ -20,6 +21,7 @@ mod tree;
 use glam::{Vec2, Vec3};
 
 pub use area::{AreaLight, EmittingMesh, LightShape, parallelogram_of};
+pub use emission_image::EmissionImage;
 pub use environment::{EnvironmentMap, EnvironmentPicture, rotation_of};
 pub use image_point::{GoniometricLight, ProjectionLight};
 pub use sampler::{

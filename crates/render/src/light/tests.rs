@@ -61,6 +61,7 @@ fn square_light(side: f32, height: f32, l: f32) -> Vec<Light> {
                 },
                 l: Rgb::splat(l),
                 two_sided: false,
+                image: None,
             })
         })
         .collect()
@@ -99,6 +100,7 @@ fn sphere_light_irradiance_is_pi_l_sin2() {
         },
         l: Rgb::splat(2.0),
         two_sided: false,
+        image: None,
     });
     let exact = std::f64::consts::PI * 2.0 / 16.0;
     let (e, se) = irradiance(&light, Vec3::ZERO, Vec3::Z, 50_000);
@@ -201,6 +203,7 @@ fn parallelogram_and_mesh_lights_match_the_corner_form_factor() {
             shape,
             l: Rgb::splat(1.0),
             two_sided: false,
+            image: None,
         })
     };
     let parallelogram = light(LightShape::Parallelogram {
@@ -213,6 +216,7 @@ fn parallelogram_and_mesh_lights_match_the_corner_form_factor() {
     let mesh = light(LightShape::Mesh(Box::new(EmittingMesh::new(
         vec![a, b],
         vec![-Vec3::Z; 2],
+        Vec::new(),
     ))));
     let exact = unit_square_corner_irradiance();
     for (name, l) in [("parallelogram", parallelogram), ("mesh", mesh)] {

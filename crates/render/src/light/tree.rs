@@ -482,6 +482,7 @@ mod tests {
                 },
                 l: Rgb::splat(1.0 + rng.uniform() * 4.0),
                 two_sided: i % 5 == 0,
+                image: None,
             }));
         }
         lights.push(Light::Point {
@@ -635,6 +636,7 @@ mod tests {
                 },
                 l: Rgb::splat(l),
                 two_sided: false,
+                image: None,
             })
         };
         let lights = [tri(Vec3::ZERO, 1.0), tri(Vec3::new(100.0, 0.0, 0.0), 10.0)];

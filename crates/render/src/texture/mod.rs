@@ -262,6 +262,15 @@ impl TextureSet {
         concrete_material(desc, |p| self.float(p, ctx), |p| self.spectrum(p, ctx))
     }
 
+    /// The mean of a float parameter over the (u, v) square, as
+    /// [`uv_average`](Self::uv_average).
+    pub fn uv_average_float(&self, p: FloatParam, n: u32) -> f32 {
+        match p {
+            TexturedParam::Constant(v) => v,
+            TexturedParam::Texture(id) => self.uv_average(TexturedParam::Texture(id), n).r,
+        }
+    }
+
     /// The mean of a spectrum parameter over the (u, v) square, from an n × n grid of
     /// point lookups at cell centres (for radiosity, whose patches carry one
     /// reflectance, and for the representative material of a textured one).
@@ -305,7 +314,7 @@ pub fn concrete_material(
         } => {
             let (alpha_u, alpha_v) = roughness.alphas(float(roughness.u), float(roughness.v));
             MaterialDesc::RoughConductor {
-                conductor: conductor.clone(),
+                conductor: conductor.concrete(&spectrum),
                 alpha_u,
                 alpha_v,
             }
@@ -320,8 +329,21 @@ pub fn concrete_material(
         },
         TexturedMaterialDesc::CoatedDiffuse { reflectance, coat } => MaterialDesc::CoatedDiffuse {
             reflectance: spectrum(*reflectance),
-            coat: *coat,
+            coat: coat.concrete(&float, &spectrum),
         },
+        TexturedMaterialDesc::CoatedConductor {
+            conductor,
+            roughness,
+            coat,
+        } => {
+            let (alpha_u, alpha_v) = roughness.alphas(float(roughness.u), float(roughness.v));
+            MaterialDesc::CoatedConductor {
+                conductor: conductor.concrete(&spectrum),
+                alpha_u,
+                alpha_v,
+                coat: coat.concrete(&float, &spectrum),
+            }
+        }
     };
     Material::from_desc(&plain)
 }

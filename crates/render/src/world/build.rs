@@ -1,18 +1,21 @@
 //! Building the world from a scene description: geometry to render space in flat
 //! arrays, one light per emitting primitive, the BVH over everything.
 
+use std::collections::HashMap;
 use std::sync::Arc;
 
 use glam::{Mat3, Vec2, Vec3};
 
-use super::shapes::{BilinearPrim, Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr};
+use super::shapes::{
+    BilinearPrim, Instance, MeshAttrs, Placed, PrimRef, ShapeSet, TriangleAttr, triangle_uvs,
+};
 use super::{MAX_MIX_DEPTH, MaterialEntry, NO_LIGHT, World};
 use crate::camera::RaySpread;
 use crate::geometry::bilinear::BilinearPatch;
 use crate::geometry::disk::Disk;
 use crate::geometry::sphere::Sphere;
 use crate::light::{
-    AreaLight, EmittingMesh, EnvironmentMap, EnvironmentPicture, GoniometricLight,
+    AreaLight, EmissionImage, EmittingMesh, EnvironmentMap, EnvironmentPicture, GoniometricLight,
     LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, Light, LightSampler, LightShape, ProjectionLight,
     SceneSphere, parallelogram_of, rotation_of,
 };
@@ -32,14 +35,7 @@ const AVERAGE_GRID: u32 = 8;
 fn representative(desc: &TexturedMaterialDesc, textures: &TextureSet) -> Material {
     concrete_material(
         desc,
-        |p| match p {
-            TexturedParam::Constant(v) => v,
-            TexturedParam::Texture(id) => {
-                textures
-                    .uv_average(TexturedParam::Texture(id), AVERAGE_GRID)
-                    .r
-            }
-        },
+        |p| textures.uv_average_float(p, AVERAGE_GRID),
         |p| textures.uv_average(p, AVERAGE_GRID),
     )
 }
@@ -78,12 +74,32 @@ impl World {
         }
 
         let mut top = ShapeSet::default();
+        let mut emission_images = HashMap::new();
         for shape in &desc.shapes {
+            let emitter = match (&shape.area_light, shape.alpha) {
+                (None, _) => None,
+                // Cut out everywhere: no surface, so no emission (pbrt-v4 masks it).
+                (Some(_), Some(TexturedParam::Constant(a))) if a <= 0.0 => None,
+                (Some(a), alpha) => {
+                    if alpha.is_some() {
+                        warnings.push(Warning {
+                            loc: shape.loc.clone(),
+                            message: "area light on a shape with an alpha cut-out: rays pass the cut-out parts, but light samples and photons still leave them".into(),
+                        });
+                    }
+                    Some(emitter_of(
+                        a,
+                        &mut emission_images,
+                        &shape.loc,
+                        &mut warnings,
+                    )?)
+                }
+            };
             add_shape(
                 &mut top,
                 shape,
                 &materials,
-                Some(&mut lights),
+                emitter.map(|e| (e, &mut lights)),
                 &mut warnings,
             )?;
         }
@@ -471,7 +487,14 @@ fn material_table(
         .map(|d| match d {
             MaterialDesc::Mix { materials, amount } => MaterialEntry::Mix {
                 materials: *materials,
-                amount: *amount,
+                amount: match amount {
+                    TexturedParam::Constant(a) => *a,
+                    TexturedParam::Texture(_) => textures.uv_average_float(*amount, AVERAGE_GRID),
+                },
+                amount_texture: match amount {
+                    TexturedParam::Constant(_) => None,
+                    TexturedParam::Texture(id) => Some(*id),
+                },
             },
             MaterialDesc::Textured(t) => MaterialEntry::Bsdf(representative(t, textures)),
             d => MaterialEntry::Bsdf(Material::from_desc(d)),
@@ -559,12 +582,78 @@ fn check_capacity(desc: &SceneDesc) -> Result<(), BuildError> {
     Ok(())
 }
 
-/// Adds one shape's primitives; area lights go to `lights` (None inside prototypes).
+/// What an emitting shape's lights are made of: its area light with the image read.
+#[derive(Clone, Debug)]
+struct Emitter {
+    l: Rgb,
+    two_sided: bool,
+    image: Option<Arc<EmissionImage>>,
+}
+
+/// The emitter of an area light, its image read once per file (shapes under one
+/// `AreaLightSource` share it); with `power`, `l` divided by the image's mean
+/// luminance, as pbrt-v4 normalises an image light's power.
+fn emitter_of(
+    a: &AreaLightDesc,
+    images: &mut HashMap<std::path::PathBuf, Arc<EmissionImage>>,
+    loc: &FileLoc,
+    warnings: &mut Vec<Warning>,
+) -> Result<Emitter, BuildError> {
+    let Some(picture) = &a.image else {
+        return Ok(Emitter {
+            l: a.l,
+            two_sided: a.two_sided,
+            image: None,
+        });
+    };
+    let image = match images.get(&picture.image.path) {
+        Some(img) => img.clone(),
+        None => {
+            let img = Arc::new(read_emission_image(&picture.image)?);
+            images.insert(picture.image.path.clone(), img.clone());
+            img
+        }
+    };
+    let l = image_emission_factor(a, &image).unwrap_or_else(|| {
+        warnings.push(Warning {
+            loc: loc.clone(),
+            message: "area light \"power\" ignored: the image is black".into(),
+        });
+        a.l
+    });
+    Ok(Emitter {
+        l,
+        two_sided: a.two_sided,
+        image: Some(image),
+    })
+}
+
+/// The factor an area light's `image` is multiplied by: `l`, divided by the image's
+/// mean luminance when `power` was given; `None` when that mean is 0.
+pub fn image_emission_factor(a: &AreaLightDesc, image: &EmissionImage) -> Option<Rgb> {
+    match &a.image {
+        Some(picture) if picture.per_unit_mean => {
+            let y = image.mean().luminance();
+            (y > 0.0).then(|| a.l / y)
+        }
+        _ => Some(a.l),
+    }
+}
+
+/// The picture of an area light with `filename`, read and checked (finite; negative
+/// values clamped to 0); errors located at the parameter.
+pub fn read_emission_image(image: &LightImage) -> Result<EmissionImage, BuildError> {
+    let (width, height, pixels) = read_light_image(image, "area light")?;
+    Ok(EmissionImage::new(width, height, pixels))
+}
+
+/// Adds one shape's primitives; with `emission` (never inside prototypes) its area
+/// lights go to the list.
 fn add_shape(
     set: &mut ShapeSet,
     shape: &ShapeDesc,
     materials: &[MaterialEntry],
-    lights: Option<&mut Vec<Light>>,
+    emission: Option<(Emitter, &mut Vec<Light>)>,
     warnings: &mut Vec<Warning>,
 ) -> Result<(), BuildError> {
     let material = shape.material;
@@ -574,10 +663,6 @@ fn add_shape(
             format!("material index {material} out of range"),
         ));
     }
-    let emission = match lights {
-        Some(lights) => shape.area_light.clone().map(|a| (a, lights)),
-        None => None,
-    };
     // An interface without emission is no surface at all.
     if materials[material as usize] == MaterialEntry::Bsdf(Material::Interface)
         && emission.is_none()
@@ -599,6 +684,7 @@ fn add_shape(
             indices.clone(),
             normals,
             uvs,
+            false,
             emission,
         ),
         Geometry::BilinearMesh {
@@ -648,10 +734,7 @@ fn add_shape(
                         .into(),
                 });
             }
-            add_mesh(set, shape, positions, tris, normals, uvs, emission);
-            if let Some(mesh) = set.meshes.last_mut() {
-                mesh.bilinear_halves = true;
-            }
+            add_mesh(set, shape, positions, tris, normals, uvs, true, emission);
         }
         // Quadrics are intersected in object space: under a singular transform (which
         // the parser accepted with a warning) they have collapsed and are left out.
@@ -736,11 +819,12 @@ fn non_similar_warning(shape: &ShapeDesc) -> Warning {
     }
 }
 
-fn push_light(lights: &mut Vec<Light>, a: &AreaLightDesc, shape: LightShape) -> u32 {
+fn push_light(lights: &mut Vec<Light>, a: &Emitter, shape: LightShape) -> u32 {
     lights.push(Light::Area(AreaLight {
         shape,
         l: a.l,
         two_sided: a.two_sided,
+        image: a.image.clone(),
     }));
     (lights.len() - 1) as u32
 }
@@ -748,16 +832,20 @@ fn push_light(lights: &mut Vec<Light>, a: &AreaLightDesc, shape: LightShape) -> 
 /// The light of an emitting triangle mesh (render-space vertices `p`): one triangle, a
 /// parallelogram for two that form one, else the whole mesh; `None` when no triangle
 /// has an area. With shading normals a triangle's front follows them (pbrt-v4), else
-/// the winding times `orientation`.
+/// the winding times `orientation`. With `uvs` (a light with an image: each
+/// triangle's vertex (u, v), by its index in the mesh) it is always a mesh carrying
+/// them.
 fn emitting_mesh(
     p: &[Vec3],
     indices: &[u32],
     normals: Option<&[Vec3]>,
     orientation: f32,
+    uvs: Option<&dyn Fn(usize) -> [Vec2; 3]>,
 ) -> Option<LightShape> {
     let mut triangles = Vec::new();
     let mut fronts = Vec::new();
-    for tri in indices.chunks_exact(3) {
+    let mut tuvs = Vec::new();
+    for (k, tri) in indices.chunks_exact(3).enumerate() {
         let v = [tri[0], tri[1], tri[2]].map(|i| i as usize);
         let pts = v.map(|i| p[i]);
         let cross = (pts[1] - pts[0]).cross(pts[2] - pts[0]);
@@ -772,6 +860,13 @@ fn emitting_mesh(
         }
         triangles.push(pts);
         fronts.push(front);
+        if let Some(uv_of) = uvs {
+            tuvs.push(uv_of(k));
+        }
+    }
+    if uvs.is_some() {
+        return (!triangles.is_empty())
+            .then(|| LightShape::Mesh(Box::new(EmittingMesh::new(triangles, fronts, tuvs))));
     }
     match (&triangles[..], &fronts[..]) {
         ([], _) => None,
@@ -789,15 +884,22 @@ fn emitting_mesh(
                 area: e1.cross(e2).length(),
             }),
             None => Some(LightShape::Mesh(Box::new(EmittingMesh::new(
-                triangles, fronts,
+                triangles,
+                fronts,
+                Vec::new(),
             )))),
         },
         _ => Some(LightShape::Mesh(Box::new(EmittingMesh::new(
-            triangles, fronts,
+            triangles,
+            fronts,
+            Vec::new(),
         )))),
     }
 }
 
+/// Adds a triangle mesh; `bilinear_halves` when its triangles are the halves of
+/// planar bilinear patches, in pairs (their default (u, v) is the patch's).
+#[allow(clippy::too_many_arguments)]
 fn add_mesh(
     set: &mut ShapeSet,
     shape: &ShapeDesc,
@@ -805,7 +907,8 @@ fn add_mesh(
     indices: Vec<u32>,
     normals: &Option<Vec<Vec3>>,
     uvs: &Option<Vec<Vec2>>,
-    mut emission: Option<(AreaLightDesc, &mut Vec<Light>)>,
+    bilinear_halves: bool,
+    mut emission: Option<(Emitter, &mut Vec<Light>)>,
 ) {
     let xf = shape.render_from_object;
     let ro = shape.reverse_orientation;
@@ -827,8 +930,16 @@ fn add_mesh(
     let mesh = set.meshes.len() as u32;
     let light = match &mut emission {
         None => NO_LIGHT,
-        Some((a, lights)) => emitting_mesh(&p, &indices, n.as_deref(), orientation)
-            .map_or(NO_LIGHT, |shape| push_light(lights, a, shape)),
+        Some((a, lights)) => {
+            let uv_of = |k: usize| {
+                let tri = &indices[3 * k..3 * k + 3];
+                let vi = [tri[0], tri[1], tri[2]].map(|v| v as usize);
+                triangle_uvs(uvs.as_deref(), vi, k, bilinear_halves)
+            };
+            let with_uvs: Option<&dyn Fn(usize) -> [Vec2; 3]> = a.image.is_some().then_some(&uv_of);
+            emitting_mesh(&p, &indices, n.as_deref(), orientation, with_uvs)
+                .map_or(NO_LIGHT, |shape| push_light(lights, a, shape))
+        }
     };
     for (k, tri) in indices.chunks_exact(3).enumerate() {
         let pts = [tri[0], tri[1], tri[2]].map(|i| p[i as usize]);
@@ -849,7 +960,7 @@ fn add_mesh(
         indices,
         normals: n,
         uvs: uvs.clone(),
-        bilinear_halves: false,
+        bilinear_halves,
         alpha: shape.alpha,
     });
 }

@@ -10,7 +10,7 @@ mod shapes;
 
 use glam::{Vec2, Vec3};
 
-pub use build::BuildError;
+pub use build::{BuildError, image_emission_factor, read_emission_image};
 pub use normals::ShadingNormal;
 pub use shapes::ShapeSet;
 
@@ -22,7 +22,7 @@ use crate::texture::{TextureEvalContext, TextureSet};
 use radiant_math::Frame;
 use radiant_math::color::Rgb;
 use radiant_math::hash::{hash_u64s, u32_to_unit_f32};
-use radiant_scene::{FloatParam, TexturedMaterialDesc};
+use radiant_scene::{FloatParam, TexturedMaterialDesc, TexturedParam};
 
 /// No light attached (in per-primitive light indices).
 pub const NO_LIGHT: u32 = u32::MAX;
@@ -47,7 +47,7 @@ pub struct SurfaceHit {
     pub dpdu: Vec3,
     pub dpdv: Vec3,
     /// How `p` moves from one pixel to the next (x, y): the footprint that texture
-    /// filters use. Zero until [`World::add_footprint`] sets it.
+    /// filters use. Zero unless [`World::intersect_with_footprint`] set it.
     pub dpdx: Vec3,
     pub dpdy: Vec3,
     pub material: u32,
@@ -98,10 +98,13 @@ impl SurfaceHit {
 pub enum MaterialEntry {
     Bsdf(Material),
     /// pbrt-v4's `mix`: two other entries; at each hit the second with probability
-    /// `amount`, chosen by a hash of the hit point and the outgoing direction.
+    /// `amount`, chosen by a hash of the hit point and the outgoing direction. With
+    /// `amount_texture` the probability is that float texture at the hit, and `amount`
+    /// its mean over (u, v) (for uses without a hit: radiosity, weights).
     Mix {
         materials: [u32; 2],
         amount: f32,
+        amount_texture: Option<u32>,
     },
 }
 
@@ -143,22 +146,46 @@ impl World {
     /// The shading normal is that of the hit's material (bump or normal map applied).
     /// Hits that an alpha cut-out lets through are skipped.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
-        crate::stats::add(crate::stats::Counter::ClosestHitTests, 1);
-        let mut hit = if self.cut_outs {
-            self.intersect_through_cut_outs(ray, t_max)?
-        } else {
-            self.geometry.intersect(ray, t_max, &self.prototypes)?
-        };
+        let mut hit = self.intersect_shape(ray, t_max)?;
         if !self.shading_normals.is_empty() {
             self.perturb_shading_normal(&mut hit, -ray.d.normalize());
         }
         Some(hit)
     }
 
+    /// [`intersect`](Self::intersect) for a ray of a camera path that has travelled
+    /// `travelled` before this segment: the hit also gets its pixel footprint, which
+    /// texture filters and the bump map's finite-difference step use.
+    pub fn intersect_with_footprint(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        travelled: f32,
+    ) -> Option<SurfaceHit> {
+        let mut hit = self.intersect_shape(ray, t_max)?;
+        let distance = travelled + hit.t * ray.d.length();
+        self.add_footprint(&mut hit, ray.d, distance);
+        if !self.shading_normals.is_empty() {
+            self.perturb_shading_normal(&mut hit, -ray.d.normalize());
+        }
+        Some(hit)
+    }
+
+    /// The closest hit as the shape reports it (alpha cut-outs skipped).
+    fn intersect_shape(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
+        crate::stats::add(crate::stats::Counter::ClosestHitTests, 1);
+        let hit = if self.cut_outs {
+            self.intersect_through_cut_outs(ray, t_max)?
+        } else {
+            self.geometry.intersect(ray, t_max, &self.prototypes)?
+        };
+        Some(hit)
+    }
+
     /// Tilts `hit.ns` by the bump or normal map of the material that shades it seen
     /// from `wo_world` (for a mix, the chosen material's).
     fn perturb_shading_normal(&self, hit: &mut SurfaceHit, wo_world: Vec3) {
-        let index = self.resolve_index(hit.material, hit.p, wo_world);
+        let index = self.resolve_index(hit.material, hit.p, wo_world, Some(hit));
         if let Some(Some(normal)) = self.shading_normals.get(index as usize) {
             normals::perturb(hit, normal, &self.textures);
         }
@@ -238,7 +265,7 @@ impl World {
     /// and the entries, as in pbrt-v4's `MixMaterial::ChooseMaterial`.
     /// A textured material's textures are evaluated at the hit with its footprint.
     pub fn material_at(&self, hit: &SurfaceHit, wo_world: Vec3) -> Material {
-        let index = self.resolve_index(hit.material, hit.p, wo_world);
+        let index = self.resolve_index(hit.material, hit.p, wo_world, Some(hit));
         match self.textured.get(index as usize) {
             Some(Some(desc)) => self
                 .textures
@@ -250,15 +277,33 @@ impl World {
     /// [`material_at`](Self::material_at) for an entry, point and direction, without
     /// textures (a textured material at its textures' averages).
     pub fn resolve_material(&self, index: u32, p: Vec3, wo_world: Vec3) -> Material {
-        self.entry_material(self.resolve_index(index, p, wo_world))
+        self.entry_material(self.resolve_index(index, p, wo_world, None))
     }
 
-    /// The entry a mix chain starting at `index` chooses at `p` seen from `wo_world`.
-    fn resolve_index(&self, mut index: u32, p: Vec3, wo_world: Vec3) -> u32 {
+    /// The entry a mix chain starting at `index` chooses at `p` seen from `wo_world`;
+    /// textured amounts are evaluated at `hit`, or at their mean without one.
+    fn resolve_index(
+        &self,
+        mut index: u32,
+        p: Vec3,
+        wo_world: Vec3,
+        hit: Option<&SurfaceHit>,
+    ) -> u32 {
         for _ in 0..=MAX_MIX_DEPTH {
             match self.materials[index as usize] {
                 MaterialEntry::Bsdf(_) => return index,
-                MaterialEntry::Mix { materials, amount } => {
+                MaterialEntry::Mix {
+                    materials,
+                    amount,
+                    amount_texture,
+                } => {
+                    let amount = match (amount_texture, hit) {
+                        (Some(id), Some(hit)) => self.textures.float(
+                            TexturedParam::Texture(id),
+                            &TextureEvalContext::from_hit(hit),
+                        ),
+                        _ => amount,
+                    };
                     index = choose_mixed(materials, amount, p, wo_world);
                 }
             }
@@ -284,7 +329,9 @@ impl World {
             for (i, w) in level {
                 match self.materials[i as usize] {
                     MaterialEntry::Bsdf(m) => out.push((m, w)),
-                    MaterialEntry::Mix { materials, amount } => {
+                    MaterialEntry::Mix {
+                        materials, amount, ..
+                    } => {
                         let a = amount.clamp(0.0, 1.0);
                         for (n, wn) in [(materials[0], w * (1.0 - a)), (materials[1], w * a)] {
                             match next.iter_mut().find(|(j, _)| *j == n) {
@@ -329,9 +376,11 @@ impl World {
     }
 
     /// Sets the hit's footprint for a ray of direction `d` that has travelled
-    /// `distance` from the camera (only when textures need it).
-    pub fn add_footprint(&self, hit: &mut SurfaceHit, d: Vec3, distance: f32) {
-        if self.ray_spread != RaySpread::NONE && self.has_textures() {
+    /// `distance` from the camera (only when textures or bump maps need it).
+    fn add_footprint(&self, hit: &mut SurfaceHit, d: Vec3, distance: f32) {
+        if self.ray_spread != RaySpread::NONE
+            && (self.has_textures() || !self.shading_normals.is_empty())
+        {
             (hit.dpdx, hit.dpdy) = self.ray_spread.differentials(d, distance, hit.ng);
         }
     }

@@ -410,7 +410,7 @@ impl ShapeSet {
                 n_obj,
                 uv,
             } => {
-                let (xf, material, light, reverse, phi_max, alpha) = match prim {
+                let (xf, material, light, reverse, phi_max, alpha, dpdv_obj) = match prim {
                     PrimRef::Sphere(i) => {
                         let s = &self.spheres[i as usize];
                         let phi_max = s.shape.phi_max;
@@ -421,6 +421,7 @@ impl ShapeSet {
                             s.reverse,
                             phi_max,
                             s.alpha,
+                            s.shape.dpdv(p_obj),
                         )
                     }
                     PrimRef::Disk(i) => {
@@ -433,6 +434,7 @@ impl ShapeSet {
                             d.reverse,
                             phi_max,
                             d.alpha,
+                            d.shape.dpdv(p_obj),
                         )
                     }
                     _ => unreachable!("bilinear patches are handled above; instances are resolved"),
@@ -452,7 +454,7 @@ impl ShapeSet {
                     ns: n,
                     uv,
                     dpdu,
-                    dpdv: Vec3::ZERO,
+                    dpdv: xf.vector(dpdv_obj),
                     dpdx: Vec3::ZERO,
                     dpdy: Vec3::ZERO,
                     material,
@@ -489,16 +491,12 @@ impl ShapeSet {
                 }
             }
         }
-        let tuv = match &mesh.uvs {
-            Some(uvs) => vi.map(|v| uvs[v]),
-            // The two halves of a planar bilinear patch: (p00, p10, p11), (p00, p11, p01).
-            None if mesh.bilinear_halves && attr.index.is_multiple_of(2) => {
-                [Vec2::ZERO, Vec2::X, Vec2::ONE]
-            }
-            None if mesh.bilinear_halves => [Vec2::ZERO, Vec2::ONE, Vec2::Y],
-            // pbrt's default parameterisation: (0,0), (1,0), (1,1).
-            None => [Vec2::ZERO, Vec2::X, Vec2::ONE],
-        };
+        let tuv = triangle_uvs(
+            mesh.uvs.as_deref(),
+            vi,
+            attr.index as usize,
+            mesh.bilinear_halves,
+        );
         let uv = b[0] * tuv[0] + b[1] * tuv[1] + b[2] * tuv[2];
         let (dpdu, dpdv) = triangle_tangents([p0, p1, p2], tuv);
         SurfaceHit {
@@ -516,6 +514,24 @@ impl ShapeSet {
             light: attr.light,
             alpha: mesh.alpha,
         }
+    }
+}
+
+/// The (u, v) at the vertices `vi` of triangle `index` of a mesh: its `uvs`, or
+/// pbrt's default (0,0), (1,0), (1,1); for the halves of planar bilinear patches, in
+/// pairs, the patch's own parameterisation.
+pub(super) fn triangle_uvs(
+    uvs: Option<&[Vec2]>,
+    vi: [usize; 3],
+    index: usize,
+    bilinear_halves: bool,
+) -> [Vec2; 3] {
+    match uvs {
+        Some(uvs) => vi.map(|v| uvs[v]),
+        // The two halves of a planar bilinear patch: (p00, p10, p11), (p00, p11, p01).
+        None if bilinear_halves && index.is_multiple_of(2) => [Vec2::ZERO, Vec2::X, Vec2::ONE],
+        None if bilinear_halves => [Vec2::ZERO, Vec2::ONE, Vec2::Y],
+        None => [Vec2::ZERO, Vec2::X, Vec2::ONE],
     }
 }
 

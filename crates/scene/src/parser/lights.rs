@@ -17,7 +17,11 @@
 //! - `"goniometric"`: `I`, `scale`, `power`, `filename` (a square equal-area
 //!   octahedral image; its RGB channels are averaged).
 //! - `"projection"`: `filename`, `fov` 90°, `scale`, `power`.
-//! - `AreaLightSource "diffuse"`: `L`, `scale`, `twosided` (false), `power`.
+//! - `AreaLightSource "diffuse"`: `L` or `filename` (an image looked up at the
+//!   surface's (u, 1 − v)), `scale`, `twosided` (false), `power`.
+//!
+//! `power` and `illuminance` set the emission before `scale`, which multiplies the
+//! result (pbrt-v4 multiplies its scale by power / k_e).
 
 use glam::Vec3;
 
@@ -38,6 +42,14 @@ fn photometric_factor(emission: Rgb, target: f32) -> f32 {
     } else {
         1.0
     }
+}
+
+/// The power a light whose emission includes `scale` must have so that `power` applies
+/// to the emission before `scale`, as in pbrt-v4 (which multiplies its scale by
+/// power / k_e): the scale then multiplies the normalised light (exact for pbrt-v4's
+/// float `scale`; a pbrt-v3 spectral scale counts by its luminance).
+fn scaled_target(power: Option<f32>, scale: Rgb) -> Option<f32> {
+    power.map(|phi| phi * scale.luminance())
 }
 
 impl Parser {
@@ -95,8 +107,9 @@ impl Parser {
         let light = match name.as_str() {
             "point" | "spot" => {
                 let scale = self.light_scale(&ps, &owner)?;
-                let i = self.spectrum_or(&ps, "I", SpectrumUse::Illuminant, Rgb::WHITE, &owner)?
-                    * scale;
+                let written =
+                    self.spectrum_or(&ps, "I", SpectrumUse::Illuminant, Rgb::WHITE, &owner)?;
+                let i = written * scale;
                 let power = Self::optional_positive(&ps, "power")?;
                 let from = ps.point3("from", Vec3::ZERO)?;
                 let position = ctm.point(from);
@@ -105,7 +118,7 @@ impl Parser {
                         position,
                         // Φ = 4π I for an isotropic point light.
                         intensity: power
-                            .map_or(i, |phi| i * photometric_factor(i, phi / (4.0 * PI))),
+                            .map_or(i, |phi| i * photometric_factor(written, phi / (4.0 * PI))),
                         loc: loc.clone(),
                     }
                 } else {
@@ -132,7 +145,7 @@ impl Parser {
                         position,
                         direction,
                         intensity: power
-                            .map_or(i, |phi| i * photometric_factor(i, phi / solid_angle)),
+                            .map_or(i, |phi| i * photometric_factor(written, phi / solid_angle)),
                         cos_falloff_start,
                         cos_total_width,
                         loc: loc.clone(),
@@ -141,8 +154,9 @@ impl Parser {
             }
             "distant" | "infinite" => {
                 let scale = self.light_scale(&ps, &owner)?;
-                let l = self.spectrum_or(&ps, "L", SpectrumUse::Illuminant, Rgb::WHITE, &owner)?
-                    * scale;
+                let written =
+                    self.spectrum_or(&ps, "L", SpectrumUse::Illuminant, Rgb::WHITE, &owner)?;
+                let l = written * scale;
                 let e = Self::optional_positive(&ps, "illuminance")?;
                 if name == "distant" {
                     let from = ps.point3("from", Vec3::ZERO)?;
@@ -158,18 +172,18 @@ impl Parser {
                         direction,
                         // A distant light's "radiance" is the irradiance it delivers
                         // on a surface facing it.
-                        radiance: e.map_or(l, |e| l * photometric_factor(l, e)),
+                        radiance: e.map_or(l, |e| l * photometric_factor(written, e)),
                         loc: loc.clone(),
                     }
                 } else {
-                    self.infinite_light(&ps, l, e, &owner, loc)?
+                    self.infinite_light(&ps, written, scale, e, &owner, loc)?
                 }
             }
             "goniometric" => {
                 let scale = self.light_scale(&ps, &owner)?;
                 let i = self.spectrum_or(&ps, "I", SpectrumUse::Illuminant, Rgb::WHITE, &owner)?
                     * scale;
-                let power = Self::optional_positive(&ps, "power")?;
+                let power = scaled_target(Self::optional_positive(&ps, "power")?, scale);
                 let image = self.light_image(&ps)?;
                 if image.is_none() {
                     self.warn(
@@ -187,7 +201,7 @@ impl Parser {
             }
             "projection" => {
                 let scale = self.light_scale(&ps, &owner)?;
-                let power = Self::optional_positive(&ps, "power")?;
+                let power = scaled_target(Self::optional_positive(&ps, "power")?, scale);
                 let fov = ps.finite_float("fov", 90.0)?;
                 if !(fov > 0.0 && fov < 180.0) {
                     let at = ps.lookup("fov").map_or(loc.clone(), |p| p.loc.clone());
@@ -229,12 +243,13 @@ impl Parser {
         }))
     }
 
-    /// `LightSource "infinite"`: constant `l`, or the image of `filename` times the
-    /// scale in `l`; `e` the `illuminance` asked for.
+    /// `LightSource "infinite"`: constant `written` × `scale`, or the image of
+    /// `filename` times `scale`; `e` the `illuminance` asked for (before `scale`).
     fn infinite_light(
         &mut self,
         ps: &ParamSet,
-        l: Rgb,
+        written: Rgb,
+        scale: Rgb,
         e: Option<f32>,
         owner: &str,
         loc: &FileLoc,
@@ -250,12 +265,14 @@ impl Parser {
             return Ok(LightDesc::Infinite {
                 // Constant L over the upper hemisphere gives E = π L on an
                 // upward-facing surface.
-                radiance: e.map_or(l, |e| l * photometric_factor(l, e / PI)),
+                radiance: e.map_or(written * scale, |e| {
+                    written * scale * photometric_factor(written, e / PI)
+                }),
                 image: None,
                 loc: loc.clone(),
             });
         };
-        let [written] = names else {
+        let [file] = names else {
             return Err(SceneError::at(at, "\"filename\" needs one value"));
         };
         let at = at.clone();
@@ -266,9 +283,9 @@ impl Parser {
             ));
         }
         Ok(LightDesc::Infinite {
-            radiance: l,
+            radiance: written * scale,
             image: Some(EnvironmentImage {
-                path: self.resolve_path(written),
+                path: self.resolve_path(file),
                 at,
                 illuminance: e,
                 render_from_light: self.gs.ctm,
@@ -289,18 +306,22 @@ impl Parser {
             ));
         }
         let scale = self.light_scale(&ps, &owner)?;
-        let l = self.spectrum_or(&ps, "L", SpectrumUse::Illuminant, Rgb::WHITE, &owner)? * scale;
-        if let Some(p) = ps.lookup("filename") {
-            let at = p.loc.clone();
-            self.warn(
-                &at,
-                format!("{owner}: image emission is not supported; using constant L"),
-            );
+        let image = self.light_image(&ps)?;
+        if image.is_some()
+            && let Some(p) = ps.lookup("L")
+        {
+            return Err(SceneError::at(
+                &p.loc,
+                format!("{owner}: give either \"L\" or \"filename\", not both"),
+            ));
         }
+        let l = self.spectrum_or(&ps, "L", SpectrumUse::Illuminant, Rgb::WHITE, &owner)?;
         let state = AreaLightState {
             l,
+            scale,
             two_sided: ps.bool("twosided", false)?,
             power: Self::optional_positive(&ps, "power")?,
+            image,
         };
         self.report_unused(&ps, &owner);
         self.gs.area_light = Some(state);

@@ -9,7 +9,8 @@
 //! - `"diffusetransmission"`: `reflectance` and `transmittance` (spectra or spectrum
 //!   textures, default 0.25), both multiplied by `scale` (float, default 1).
 //! - `"mix"`: `materials` (two named materials, defined before the mix) and `amount`
-//!   (float, default 0.5): the probability of the second material at a hit.
+//!   (float or float texture, default 0.5): the probability of the second material at
+//!   a hit.
 //! - `"interface"` (also `""`, `"none"`): no surface.
 //! - `dielectric` and `conductor` take pbrt-v4's microfacet roughness: `roughness`
 //!   (default 0) sets both `uroughness` and `vroughness` unless they are given, and
@@ -28,8 +29,8 @@
 //!   `maxdepth`, `nsamples` without prefix) over a conductor read as `conductor`
 //!   reads it, its parameters prefixed `conductor.` (`conductor.eta` / `conductor.k`,
 //!   default copper, or `reflectance`; `conductor.roughness`, ...).
-//! - Textured floats of the layered materials (`thickness`, `g`, roughness) are
-//!   reported and read as their defaults.
+//! - Textures may give the layered materials' roughnesses, `thickness`, `albedo` and
+//!   `g`, and a conductor's `reflectance`, `eta` and `k`.
 //! - Any material takes `displacement` (a float texture: bump mapping) or
 //!   `normalmap` (an image file, relative to the scene file); see
 //!   [`crate::ShadingNormalDesc`].
@@ -40,13 +41,14 @@
 use super::Parser;
 use super::spectrum_param::SpectrumUse;
 use super::state::with_defaults;
-use crate::desc::{CoatDesc, ConductorDesc, MaterialDesc, MaterialId};
+use crate::desc::{ConductorDesc, MaterialDesc, MaterialId};
 use crate::error::{FileLoc, SceneError};
 use crate::named_spectra::{glass_eta, metal_spectrum};
 use crate::params::{ParamSet, ParamValue};
 use crate::spectrum::{interpolate, pairs_from_flat};
 use crate::texture::{
-    FloatParam, RoughnessDesc, ShadingNormalDesc, TexturedMaterialDesc, TexturedParam,
+    FloatParam, RoughnessDesc, ShadingNormalDesc, TexturedCoatDesc, TexturedConductorDesc,
+    TexturedMaterialDesc, TexturedParam,
 };
 use radiant_math::color::Rgb;
 
@@ -226,20 +228,20 @@ impl Parser {
             }
             "conductor" => {
                 let alpha = self.microfacet_alpha(ps, "")?;
-                let conductor = self.conductor_desc(ps, "", owner)?;
-                match alpha {
-                    Alpha::Smooth => MaterialDesc::Conductor(conductor),
-                    Alpha::Constant(alpha_u, alpha_v) => MaterialDesc::RoughConductor {
-                        conductor,
-                        alpha_u,
-                        alpha_v,
-                    },
-                    Alpha::Textured(roughness) => {
-                        MaterialDesc::Textured(TexturedMaterialDesc::RoughConductor {
+                let conductor = self.conductor_desc(ps, "")?;
+                match (alpha, constant_conductor(&conductor)) {
+                    (Alpha::Smooth, Some(conductor)) => MaterialDesc::Conductor(conductor),
+                    (Alpha::Constant(alpha_u, alpha_v), Some(conductor)) => {
+                        MaterialDesc::RoughConductor {
                             conductor,
-                            roughness,
-                        })
+                            alpha_u,
+                            alpha_v,
+                        }
                     }
+                    (alpha, _) => MaterialDesc::Textured(TexturedMaterialDesc::RoughConductor {
+                        conductor,
+                        roughness: alpha.roughness(),
+                    }),
                 }
             }
             "coateddiffuse" => {
@@ -250,25 +252,42 @@ impl Parser {
                     Rgb::splat(0.5),
                 )?;
                 let coat = self.coat_desc(ps, "", loc, owner)?;
-                match reflectance {
-                    TexturedParam::Constant(reflectance) => {
+                match (reflectance, coat.constant()) {
+                    (TexturedParam::Constant(reflectance), Some(coat)) => {
                         MaterialDesc::CoatedDiffuse { reflectance, coat }
                     }
-                    reflectance => MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse {
-                        reflectance,
-                        coat,
-                    }),
+                    (reflectance, _) => {
+                        MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse {
+                            reflectance,
+                            coat,
+                        })
+                    }
                 }
             }
             "coatedconductor" => {
                 let coat = self.coat_desc(ps, "interface.", loc, owner)?;
-                let (alpha_u, alpha_v) = self.constant_alpha(ps, "conductor.", owner)?;
-                let conductor = self.conductor_desc(ps, "conductor.", owner)?;
-                MaterialDesc::CoatedConductor {
-                    conductor,
-                    alpha_u,
-                    alpha_v,
-                    coat,
+                let roughness = self.microfacet_alpha(ps, "conductor.")?.roughness();
+                let conductor = self.conductor_desc(ps, "conductor.")?;
+                let alphas = match (roughness.u, roughness.v) {
+                    (TexturedParam::Constant(u), TexturedParam::Constant(v)) => {
+                        Some(roughness.alphas(u, v))
+                    }
+                    _ => None,
+                };
+                match (alphas, constant_conductor(&conductor), coat.constant()) {
+                    (Some((alpha_u, alpha_v)), Some(conductor), Some(coat)) => {
+                        MaterialDesc::CoatedConductor {
+                            conductor,
+                            alpha_u,
+                            alpha_v,
+                            coat,
+                        }
+                    }
+                    _ => MaterialDesc::Textured(TexturedMaterialDesc::CoatedConductor {
+                        conductor,
+                        roughness,
+                        coat,
+                    }),
                 }
             }
             "thindielectric" => MaterialDesc::ThinDielectric {
@@ -351,71 +370,50 @@ impl Parser {
                 ));
             }
         };
-        let amount = match ps.lookup("amount").map(|p| (&p.value, p.loc.clone())) {
-            None => 0.5,
-            Some((ParamValue::Float(v), at)) if v.len() == 1 => {
-                if !v[0].is_finite() {
-                    return Err(SceneError::at(&at, "\"amount\" must be finite"));
-                }
-                v[0]
-            }
-            Some((ParamValue::Texture(_), at)) => {
-                self.warn(
-                    &at,
-                    format!("{owner}: textured \"amount\" is not supported; read as 0.5"),
-                );
-                0.5
-            }
-            Some((other, at)) => {
-                return Err(SceneError::at(
-                    &at,
-                    format!(
-                        "parameter \"amount\" has type \"{}\" or the wrong count; expected one float",
-                        other.type_name()
-                    ),
-                ));
-            }
-        };
+        let amount = self.float_texture_param(ps, "amount", 0.5)?;
         Ok(MaterialDesc::Mix { materials, amount })
     }
 
     /// A conductor's `reflectance`, else its `eta` and `k` (default copper), these
     /// two named with `prefix` (pbrt-v4 names a coated conductor's colour
-    /// `reflectance`, its index `conductor.eta`).
+    /// `reflectance`, its index `conductor.eta`); each may be a spectrum texture.
     fn conductor_desc(
         &mut self,
         ps: &ParamSet,
         prefix: &str,
-        owner: &str,
-    ) -> Result<ConductorDesc, SceneError> {
+    ) -> Result<TexturedConductorDesc, SceneError> {
         let name = |n: &str| format!("{prefix}{n}");
         if ps.has("reflectance") {
-            let r = self.spectrum_or(ps, "reflectance", SpectrumUse::Albedo, Rgb::WHITE, owner)?;
+            let r =
+                self.spectrum_texture_param(ps, "reflectance", SpectrumUse::Albedo, Rgb::WHITE)?;
             ps.lookup(&name("eta"));
             ps.lookup(&name("k"));
-            return Ok(ConductorDesc::Reflectance(r));
+            return Ok(TexturedConductorDesc::Reflectance(r));
         }
         let cu_eta = metal_spectrum("metal-Cu-eta").expect("built-in table");
         let cu_k = metal_spectrum("metal-Cu-k").expect("built-in table");
-        Ok(ConductorDesc::EtaK {
-            eta: self.spectrum_or(ps, &name("eta"), SpectrumUse::Unbounded, cu_eta, owner)?,
-            k: self.spectrum_or(ps, &name("k"), SpectrumUse::Unbounded, cu_k, owner)?,
+        Ok(TexturedConductorDesc::EtaK {
+            eta: self.spectrum_texture_param(ps, &name("eta"), SpectrumUse::Unbounded, cu_eta)?,
+            k: self.spectrum_texture_param(ps, &name("k"), SpectrumUse::Unbounded, cu_k)?,
         })
     }
 
     /// The coat (roughness and index named with `prefix`) and slab of a layered
-    /// material, with pbrt-v4's defaults.
+    /// material, with pbrt-v4's defaults; roughness, `thickness`, `albedo` and `g` may
+    /// be textures (constant values are checked here).
     fn coat_desc(
         &mut self,
         ps: &ParamSet,
         prefix: &str,
         loc: &FileLoc,
         owner: &str,
-    ) -> Result<CoatDesc, SceneError> {
-        let (alpha_u, alpha_v) = self.constant_alpha(ps, prefix, owner)?;
+    ) -> Result<TexturedCoatDesc, SceneError> {
+        let roughness = self.microfacet_alpha(ps, prefix)?.roughness();
         let eta = self.dielectric_eta(ps, &format!("{prefix}eta"), owner)?;
-        let thickness = self.layer_float(ps, "thickness", 0.01, owner)?;
-        if thickness <= 0.0 {
+        let thickness = self.float_texture_param(ps, "thickness", 0.01)?;
+        if let TexturedParam::Constant(thickness) = thickness
+            && thickness <= 0.0
+        {
             let at = ps
                 .lookup("thickness")
                 .map_or(loc.clone(), |p| p.loc.clone());
@@ -424,15 +422,17 @@ impl Parser {
                 format!("\"thickness\" {thickness} must be positive"),
             ));
         }
-        let g = self.layer_float(ps, "g", 0.0, owner)?;
-        if !(g > -1.0 && g < 1.0) {
+        let g = self.float_texture_param(ps, "g", 0.0)?;
+        if let TexturedParam::Constant(g) = g
+            && !(g > -1.0 && g < 1.0)
+        {
             let at = ps.lookup("g").map_or(loc.clone(), |p| p.loc.clone());
             return Err(SceneError::at(
                 &at,
                 format!("\"g\" {g} must lie in (-1, 1)"),
             ));
         }
-        let albedo = self.spectrum_or(ps, "albedo", SpectrumUse::Albedo, Rgb::BLACK, owner)?;
+        let albedo = self.spectrum_texture_param(ps, "albedo", SpectrumUse::Albedo, Rgb::BLACK)?;
         let max_depth = ps.count("maxdepth", 10)?;
         let samples = ps.count("nsamples", 1)?;
         for (name, v) in [("maxdepth", max_depth), ("nsamples", samples)] {
@@ -444,38 +444,15 @@ impl Parser {
                 ));
             }
         }
-        Ok(CoatDesc {
+        Ok(TexturedCoatDesc {
             eta,
-            alpha_u,
-            alpha_v,
+            roughness,
             thickness,
-            albedo: albedo.map(|c| c.clamp(0.0, 1.0)),
+            albedo,
             g,
             max_depth,
             samples,
         })
-    }
-
-    /// A finite float of a layered material; a texture is reported and read as
-    /// `default`.
-    fn layer_float(
-        &mut self,
-        ps: &ParamSet,
-        name: &str,
-        default: f32,
-        owner: &str,
-    ) -> Result<f32, SceneError> {
-        if let Some(p) = ps.lookup(name)
-            && let ParamValue::Texture(_) = &p.value
-        {
-            let at = p.loc.clone();
-            self.warn(
-                &at,
-                format!("{owner}: textured \"{name}\" is not supported; read as {default}"),
-            );
-            return Ok(default);
-        }
-        ps.finite_float(name, default)
     }
 
     /// The microfacet alphas (u, v) of a dielectric or conductor: smooth when both
@@ -514,32 +491,6 @@ impl Parser {
             return Ok(Alpha::Smooth);
         }
         Ok(Alpha::Constant(alpha_u, alpha_v))
-    }
-
-    /// [`microfacet_alpha`](Self::microfacet_alpha) for the layered materials, whose
-    /// roughness must be constant: a textured one is reported and read as 0.
-    fn constant_alpha(
-        &mut self,
-        ps: &ParamSet,
-        prefix: &str,
-        owner: &str,
-    ) -> Result<(f32, f32), SceneError> {
-        Ok(match self.microfacet_alpha(ps, prefix)? {
-            Alpha::Smooth => (0.0, 0.0),
-            Alpha::Constant(u, v) => (u, v),
-            Alpha::Textured(_) => {
-                let at = ["roughness", "uroughness", "vroughness"]
-                    .iter()
-                    .find_map(|n| ps.lookup(&format!("{prefix}{n}")))
-                    .map(|p| p.loc.clone())
-                    .expect("a textured roughness was read");
-                self.warn(
-                    &at,
-                    format!("{owner}: textured \"{prefix}roughness\" is not supported; read as 0"),
-                );
-                (0.0, 0.0)
-            }
-        })
     }
 
     fn dielectric_eta(
@@ -612,4 +563,31 @@ enum Alpha {
     /// Alphas (u, v), already remapped.
     Constant(f32, f32),
     Textured(RoughnessDesc),
+}
+
+impl Alpha {
+    /// The roughness as a (possibly textured) description; constants as alphas.
+    fn roughness(self) -> RoughnessDesc {
+        let alphas = |u: f32, v: f32| RoughnessDesc {
+            u: TexturedParam::Constant(u),
+            v: TexturedParam::Constant(v),
+            remap: false,
+        };
+        match self {
+            Alpha::Smooth => alphas(0.0, 0.0),
+            Alpha::Constant(u, v) => alphas(u, v),
+            Alpha::Textured(r) => r,
+        }
+    }
+}
+
+/// The conductor when none of its parameters is a texture.
+fn constant_conductor(c: &TexturedConductorDesc) -> Option<ConductorDesc> {
+    match *c {
+        TexturedConductorDesc::Reflectance(r) => Some(ConductorDesc::Reflectance(r.constant()?)),
+        TexturedConductorDesc::EtaK { eta, k } => Some(ConductorDesc::EtaK {
+            eta: eta.constant()?,
+            k: k.constant()?,
+        }),
+    }
 }

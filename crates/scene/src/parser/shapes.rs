@@ -22,7 +22,7 @@ use glam::{Vec2, Vec3};
 
 use super::Parser;
 use super::state::with_defaults;
-use crate::desc::{AreaLightDesc, Geometry, ShapeDesc};
+use crate::desc::{AreaLightDesc, AreaLightImage, Geometry, ShapeDesc};
 use crate::error::{FileLoc, SceneError};
 use crate::mesh::{
     MeshData, first_non_finite2, first_non_finite3, first_out_of_range, repair_normals,
@@ -87,17 +87,20 @@ impl Parser {
                 None
             }
             (Some(al), false) => {
-                let mut l = al.l;
+                let mut l = al.l * al.scale;
+                let mut per_unit_mean = false;
                 if let Some(power) = al.power {
-                    // Φ = π A L per emitting side for a Lambertian emitter.
+                    // Φ = π A L per emitting side for a Lambertian emitter; an image
+                    // counts by its mean luminance, divided out when it is read.
                     let area: f32 = geometries
                         .iter()
                         .map(|g| g.surface_area(&render_from_object.m))
                         .sum();
                     let sides = if al.two_sided { 2.0 } else { 1.0 };
-                    let y = l.luminance();
+                    let y = al.l.luminance();
                     if area > 0.0 && y > 0.0 {
                         l *= power / (radiant_math::PI * area * sides * y);
+                        per_unit_mean = al.image.is_some();
                     } else {
                         self.warn(
                             loc,
@@ -108,6 +111,10 @@ impl Parser {
                 Some(AreaLightDesc {
                     l,
                     two_sided: al.two_sided,
+                    image: al.image.map(|image| AreaLightImage {
+                        image,
+                        per_unit_mean,
+                    }),
                 })
             }
         };

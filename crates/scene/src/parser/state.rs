@@ -1,7 +1,7 @@
 //! The graphics state that `AttributeBegin` / `AttributeEnd` save and restore: current
 //! transform, orientation, material, area light and `Attribute` defaults.
 
-use crate::desc::MaterialId;
+use crate::desc::{LightImage, MaterialId};
 use crate::error::FileLoc;
 use crate::params::{Param, ParamSet};
 use radiant_math::Transform;
@@ -10,12 +10,15 @@ use radiant_math::color::Rgb;
 /// An `AreaLightSource "diffuse"` waiting for the shapes that follow it.
 #[derive(Clone, Debug)]
 pub(super) struct AreaLightState {
-    /// Radiance with `scale` applied (`power` is applied per shape, since it depends
-    /// on the shape's area).
+    /// Radiance as written (`L`; white for an image), before `scale`.
     pub l: Rgb,
+    /// `scale` (`power` is applied per shape, since it depends on the shape's area).
+    pub scale: Rgb,
     pub two_sided: bool,
     /// `"float power"`: total emitted power in watts, when given (> 0).
     pub power: Option<f32>,
+    /// `filename`: emission varying as this picture does.
+    pub image: Option<LightImage>,
 }
 
 /// Parameters given by `Attribute "<target>" …`, used by later directives of that

@@ -75,12 +75,11 @@ pub fn radiance(
     let mut prev = ChainVertex::camera(ray.o);
     for depth in 0..=settings.max_depth {
         rays += 1;
-        let Some(mut hit) = world.intersect(&ray, f32::INFINITY) else {
+        let Some(hit) = world.intersect_with_footprint(&ray, f32::INFINITY, travelled) else {
             l += beta * prev.environment(world, ray.d);
             break;
         };
         travelled += hit.t * ray.d.length();
-        world.add_footprint(&mut hit, ray.d, travelled);
         let wo_world = -ray.d.normalize();
         let emitted = prev.emission(world, &hit, wo_world);
         let material = world.material_at(&hit, wo_world);

@@ -81,12 +81,11 @@ pub fn camera_sample(
     let mut prev = ChainVertex::camera(ray.o);
     for depth in 0..=max_depth {
         out.rays += 1;
-        let Some(mut hit) = world.intersect(&ray, f32::INFINITY) else {
+        let Some(hit) = world.intersect_with_footprint(&ray, f32::INFINITY, travelled) else {
             out.ld += beta * prev.environment(world, ray.d);
             break;
         };
         travelled += hit.t * ray.d.length();
-        world.add_footprint(&mut hit, ray.d, travelled);
         let wo_world = -ray.d.normalize();
         // Specular and rough-glass vertices precede this one: emission counts in full
         // after a delta bounce, weighted against the light sample after a glossy one.
