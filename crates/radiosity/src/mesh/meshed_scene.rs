@@ -8,9 +8,11 @@
 //! `diffusetransmission` by its reflectance (the transmitted part is lost), a `mix` by
 //! the amount-weighted albedo of its two materials, and glass and metals by zero (their
 //! patches absorb; the display follows camera rays through them by their BSDF). A
-//! textured diffuse reflectance is reduced to its mean over the (u, v) square (a 16 × 16
-//! grid of point lookups), one value for all patches of the shape; so is an area light's
-//! image (its mean, with a warning). A shape with a constant alpha of 0 is left out;
+//! textured material (or mix amount) and an area light's image give each patch its own
+//! mean, over its centroid and the midpoints towards its corners, read on the shape's
+//! true surface through the render world (an image light is reported once); the
+//! shape's mean over the (u, v) square (a 16 × 16 grid of point lookups) stands where
+//! no point is found. A shape with a constant alpha of 0 is left out;
 //! other alpha cut-outs are solved as opaque (with a warning). Patches are one-sided:
 //! the front is the side the shape's
 //! normal points to (pbrt's rules: winding, `ReverseOrientation`, handedness of the
@@ -25,9 +27,11 @@ use super::face_mesh::{FaceMesh, Subdivision};
 use super::patch::PatchSet;
 use crate::settings::{DEFAULT_PATCH_COUNT, RadiositySettings, SolverKind};
 use radiant_math::color::Rgb;
+use radiant_render::geometry::Ray;
+use radiant_render::integrator::direct::surface_emission;
 use radiant_render::light::EmissionImage;
 use radiant_render::texture::{TextureSet, concrete_material};
-use radiant_render::world::{image_emission_factor, read_emission_image};
+use radiant_render::world::{World, image_emission_factor, read_emission_image};
 use radiant_scene::{
     AreaLightDesc, FileLoc, Geometry, MaterialDesc, SceneDesc, SceneError, ShapeDesc,
     TexturedMaterialDesc, TexturedParam, Warning, sphere_z_range,
@@ -48,6 +52,64 @@ pub struct SurfaceTag {
 /// Point lookups per axis over the (u, v) square for a textured reflectance's mean.
 const TEXTURE_AVERAGE_GRID: u32 = 16;
 
+/// Whether a material's diffuse albedo varies over the surface: a texture in it, or in
+/// a mix's amount or materials.
+fn varies_over_surface(materials: &[MaterialDesc], id: u32, depth: u32) -> bool {
+    match materials.get(id as usize) {
+        Some(MaterialDesc::Textured(_)) => true,
+        Some(MaterialDesc::Mix {
+            materials: m,
+            amount,
+        }) if depth < 64 => {
+            amount.constant().is_none()
+                || m.iter()
+                    .any(|&k| varies_over_surface(materials, k, depth + 1))
+        }
+        _ => false,
+    }
+}
+
+/// Gives patch `i` of a textured surface (or of a light with an image) the mean of its
+/// surface over points spread across it: the centroid and the midpoints towards each
+/// corner, each found by a ray along the patch normal to the shape's true surface
+/// (tessellated spheres and disks lie off it by their sag). Points where the ray meets
+/// another material (or nothing) are left out; without any, the patch keeps the
+/// shape's mean.
+fn patch_means(world: &World, set: &mut PatchSet, i: usize, material: u32) {
+    let polygon = set.polygon(i);
+    let patch = &set.patches[i];
+    let (n, c) = (patch.normal, patch.centroid);
+    let reach = patch.area.sqrt().max(1e-12);
+    let mut points = vec![c];
+    points.extend(polygon.as_slice().iter().map(|&q| 0.5 * (c + q)));
+    let (mut albedo, mut radiance, mut found) = (Rgb::BLACK, Rgb::BLACK, 0u32);
+    for q in points {
+        // From above the patch down its normal, then from below up it.
+        let hit = [1.0, -1.0].iter().find_map(|&side| {
+            let o = (q + side * reach * n).as_vec3();
+            let d = (-side * n).as_vec3();
+            world
+                .intersect(&Ray::new(o, d), 2.0 * reach as f32)
+                .filter(|h| h.material == material)
+        });
+        let Some(hit) = hit else { continue };
+        albedo += world.diffuse_albedo_at(&hit);
+        radiance += surface_emission(world, &hit, n.as_vec3());
+        found += 1;
+    }
+    if found == 0 {
+        return;
+    }
+    let k = 1.0 / found as f32;
+    let p = &mut set.patches[i];
+    p.reflectance = (albedo * k).to_array().map(|r| (r as f64).clamp(0.0, 1.0));
+    if p.emission != [0.0; 3] {
+        p.emission = (radiance * k)
+            .to_array()
+            .map(|l| std::f64::consts::PI * l.max(0.0) as f64);
+    }
+}
+
 /// The radiance an area light's patches emit: `l`, or for a light with an image its
 /// mean over the image (one value per shape, as for textured reflectances; reported
 /// once per image). Images are read once per file.
@@ -66,7 +128,7 @@ fn area_light_mean(
         warnings.push(Warning {
             loc: loc.clone(),
             message: format!(
-                "radiosity: the area light's image '{}' is emitted as its mean radiance over each shape",
+                "radiosity: the area light's image '{}' is emitted as its mean radiance over each patch",
                 path.display()
             ),
         });
@@ -308,6 +370,26 @@ impl RadiosityScene {
             let t = &tags[tag as usize];
             (t.emission, t.reflectance)
         });
+        let varying: Vec<bool> = tags
+            .iter()
+            .map(|t| {
+                varies_over_surface(&desc.materials, t.material, 0)
+                    || shapes[t.shape as usize]
+                        .0
+                        .area_light
+                        .as_ref()
+                        .is_some_and(|a| a.image.is_some())
+            })
+            .collect();
+        if varying.contains(&true) {
+            let (world, _) = World::build(desc)?;
+            for (i, &face) in patch_face.iter().enumerate() {
+                let tag = faces.faces[face as usize].tag as usize;
+                if varying[tag] {
+                    patch_means(&world, &mut set, i, tags[tag].material);
+                }
+            }
+        }
         // Back sides: the same points in reverse order, so both sides share vertices
         // and every back patch knows its front twin.
         let front_count = set.len();

@@ -397,10 +397,10 @@ fn non_diffuse_materials_use_their_diffuse_albedo_with_one_warning_each() {
     assert!(close(reflectance(5), [0.6; 3]), "{:?}", reflectance(5));
 }
 
-/// Textured inputs become one value per shape: an area light's image emits its mean
-/// (times `scale`; with `power`, normalised by the image's mean luminance as the
-/// renderer does), with one warning naming the file, and a textured mix amount counts
-/// by its mean over (u, v).
+/// Textured inputs: each shape's tag holds its mean (an area light's image times
+/// `scale`; with `power`, normalised by the image's mean luminance as the renderer
+/// does; a textured mix amount by its mean over (u, v)), with one warning naming the
+/// image, and each patch its own mean over the part of the surface it covers.
 #[test]
 fn image_emission_and_textured_mix_amounts_enter_by_their_means() {
     let dir = std::env::temp_dir().join(format!("radiant-radiosity-images-{}", std::process::id()));
@@ -434,7 +434,7 @@ fn image_emission_and_textured_mix_amounts_enter_by_their_means() {
         quad(2.0),
     );
     let desc = radiant_scene::parse_str(&text, "t.pbrt", &dir).unwrap();
-    let scene = RadiosityScene::from_desc(&desc, &settings_with_area(1.0)).unwrap();
+    let scene = RadiosityScene::from_desc(&desc, &settings_with_area(0.01)).unwrap();
     let image_warnings = scene
         .warnings
         .iter()
@@ -455,6 +455,53 @@ fn image_emission_and_textured_mix_amounts_enter_by_their_means() {
     // Half black by the amount's mean: 0.4.
     let r = tag(2).reflectance;
     assert!((r[1] - 0.4).abs() < 1e-6, "{r:?}");
+    // Per patch: white where u < 1/2 (x < 1/2), black beyond, the patches across the
+    // edge in between; the image's left column (texels 0 and 2, red 0 and 2) emits
+    // less red than its right (1 and 3).
+    let (mut white, mut black) = (0, 0);
+    let (mut left, mut right) = (Vec::new(), Vec::new());
+    for (i, p) in scene.patches.patches.iter().enumerate() {
+        let shape = scene.tag(i).shape;
+        let x = p.centroid.x;
+        let polygon = scene.patches.polygon(i);
+        let xs = polygon.as_slice().iter().map(|q| q.x);
+        let (lo, hi) = (
+            xs.clone().fold(f64::MAX, f64::min),
+            xs.fold(f64::MIN, f64::max),
+        );
+        if shape == 2 && hi <= 0.5 + 1e-9 {
+            assert!(
+                (p.reflectance[1] - 0.8).abs() < 1e-6,
+                "{i} at x {x}: {:?}",
+                p.reflectance
+            );
+            white += 1;
+        } else if shape == 2 && lo >= 0.5 - 1e-9 {
+            assert!(
+                p.reflectance[1].abs() < 1e-6,
+                "{i} at x {x}: {:?}",
+                p.reflectance
+            );
+            black += 1;
+        } else if shape == 0 && hi <= 0.25 + 1e-9 {
+            left.push(p.emission[0]);
+        } else if shape == 0 && lo >= 0.75 - 1e-9 {
+            right.push(p.emission[0]);
+        }
+    }
+    assert!(white > 0 && black > 0 && !left.is_empty() && !right.is_empty());
+    // Red over the columns, times the scale: 2 (texels 0, 2) and 4 (texels 1, 3).
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    assert!(
+        (mean(&left) / pi - 2.0).abs() < 0.3,
+        "left {}",
+        mean(&left) / pi
+    );
+    assert!(
+        (mean(&right) / pi - 4.0).abs() < 0.3,
+        "right {}",
+        mean(&right) / pi
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -350,6 +350,37 @@ impl World {
         out
     }
 
+    /// The diffuse albedo of the material at `hit` with its textures (a textured
+    /// mix amount included) evaluated there, a mix's the amount-weighted mean of its
+    /// materials': what radiosity gives a patch at that point.
+    pub fn diffuse_albedo_at(&self, hit: &SurfaceHit) -> Rgb {
+        let ctx = TextureEvalContext::from_hit(hit);
+        self.entry_albedo_at(hit.material, &ctx, 0)
+    }
+
+    fn entry_albedo_at(&self, index: u32, ctx: &TextureEvalContext, depth: usize) -> Rgb {
+        match self.materials[index as usize] {
+            MaterialEntry::Bsdf(m) => match self.textured.get(index as usize) {
+                Some(Some(desc)) => self.textures.material(desc, ctx).diffuse_albedo(),
+                _ => m.diffuse_albedo(),
+            },
+            MaterialEntry::Mix { .. } if depth > MAX_MIX_DEPTH => Rgb::BLACK,
+            MaterialEntry::Mix {
+                materials,
+                amount,
+                amount_texture,
+            } => {
+                let a = amount_texture
+                    .map_or(amount, |id| {
+                        self.textures.float(TexturedParam::Texture(id), ctx)
+                    })
+                    .clamp(0.0, 1.0);
+                self.entry_albedo_at(materials[0], ctx, depth + 1) * (1.0 - a)
+                    + self.entry_albedo_at(materials[1], ctx, depth + 1) * a
+            }
+        }
+    }
+
     /// The diffuse albedo of an entry: a mix's is the amount-weighted mean of its
     /// materials' (what radiosity and final gathering use).
     pub fn diffuse_albedo(&self, index: u32) -> Rgb {
