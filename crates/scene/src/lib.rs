@@ -14,6 +14,7 @@ pub mod obj;
 pub mod params;
 pub mod parser;
 pub mod ply;
+pub mod reflectance_spectrum;
 pub mod spectrum;
 pub mod subdiv;
 pub mod texture;

@@ -8,7 +8,8 @@ use radiant_scene::named_spectra::metal_spectrum;
 use radiant_scene::spectrum::blackbody_rgb;
 use radiant_scene::{
     CameraKind, CoatDesc, ConductorDesc, DigitRandomization, FilterKind, Geometry, LightDesc,
-    MaterialDesc, SamplerKind, SceneDesc, TexturedMaterialDesc, TexturedParam, parse_str,
+    MaterialDesc, RoughnessDesc, SamplerKind, SceneDesc, TexturedCoatDesc, TexturedMaterialDesc,
+    TexturedParam, parse_str,
 };
 
 fn parse(text: &str) -> SceneDesc {
@@ -321,6 +322,7 @@ fn coated_materials_follow_pbrt_v4() {
            \"spectrum conductor.eta\" \"metal-Au-eta\" \"spectrum conductor.k\" \"metal-Au-k\"\n\
            \"float conductor.uroughness\" 0.3 \"float conductor.vroughness\" 0.3 \"bool remaproughness\" false\n\
          Material \"coatedconductor\" \"rgb reflectance\" [ 0.9 0.8 0.7 ]\n\
+         Texture \"t\" \"float\" \"constant\" \"float value\" 0.3\n\
          Material \"coateddiffuse\" \"texture thickness\" \"t\"\n",
     );
     let pbrt_default = CoatDesc {
@@ -371,15 +373,26 @@ fn coated_materials_follow_pbrt_v4() {
             alpha_v: 0.0,
             coat: pbrt_default,
         },
-        MaterialDesc::CoatedDiffuse {
-            reflectance: Rgb::splat(0.5),
-            coat: pbrt_default,
-        },
+        MaterialDesc::Textured(TexturedMaterialDesc::CoatedDiffuse {
+            reflectance: TexturedParam::Constant(Rgb::splat(0.5)),
+            coat: TexturedCoatDesc {
+                eta: 1.5,
+                roughness: RoughnessDesc {
+                    u: TexturedParam::Constant(0.0),
+                    v: TexturedParam::Constant(0.0),
+                    remap: false,
+                },
+                thickness: TexturedParam::Texture(0),
+                albedo: TexturedParam::Constant(Rgb::BLACK),
+                g: TexturedParam::Constant(0.0),
+                max_depth: 10,
+                samples: 1,
+            },
+        }),
     ];
     assert_eq!(s.materials, expected);
-    // Only the textured thickness is reported; no parameter is left unused.
-    assert_eq!(s.warnings.len(), 1, "{:#?}", s.warnings);
-    assert!(s.warnings[0].message.contains("textured \"thickness\""));
+    // A textured thickness is taken as it is; nothing is reported or left unused.
+    assert!(s.warnings.is_empty(), "{:#?}", s.warnings);
     for bad in [
         "\"float thickness\" 0",
         "\"float g\" 1",

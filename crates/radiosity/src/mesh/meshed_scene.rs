@@ -157,9 +157,12 @@ fn diffuse_albedos(materials: &[MaterialDesc], textures: &TextureSet) -> Vec<[f6
             | Some(MaterialDesc::DiffuseTransmission { reflectance, .. }) => clamp(*reflectance),
             // The coat's transmittance and inner reflection in closed form (see
             // `Material::diffuse_albedo`); its gloss is left out.
-            Some(d @ MaterialDesc::CoatedDiffuse { .. }) => {
-                clamp(radiant_render::material::Material::from_desc(d).diffuse_albedo())
-            }
+            Some(d @ MaterialDesc::CoatedDiffuse { .. }) => clamp(
+                radiant_render::material::Material::from_desc(
+                    &radiant_render::material::spectrally_matched(d),
+                )
+                .diffuse_albedo(),
+            ),
             // One reflectance per shape: the material with each texture at its mean
             // over (u, v).
             Some(MaterialDesc::Textured(t)) => clamp(

@@ -46,6 +46,7 @@ use radiant_math::color::Rgb;
 use radiant_math::hash::{Pcg32, hash_u64s};
 use radiant_math::sampling::{self, power_heuristic};
 use radiant_math::{Frame, INV_PI};
+use radiant_scene::reflectance_spectrum::SmoothReflectance;
 use radiant_scene::{CoatDesc, ConductorDesc};
 
 /// The dielectric coat: relative index `eta` (coat over outside) and its microfacet
@@ -686,6 +687,35 @@ impl Layered {
         let r_i = internal_reflectance(self.coat.eta);
         reflectance.map(|rho| rho * t0 * (1.0 - r_i) / (1.0 - rho * r_i))
     }
+}
+
+/// The RGB base reflectance under a coat of index `eta` whose light leaves with the
+/// colour a spectral renderer gives it. Light under a coat meets the base again and
+/// again (internal reflectance r_i): a Lambertian base of spectrum R(λ) sends out
+/// R / (1 − R r_i) at each wavelength, and the colour of that is not the same
+/// expression of the RGB — for pbrt-v4's smooth spectrum of a saturated orange
+/// (1, 0.38, 0.013) the red that leaves is 20 % below the RGB series'. The reflectance
+/// returned is the one whose RGB series equals the colour of the spectral one (for the
+/// smooth spectrum of Jakob & Hanika 2019 that pbrt-v4 uses, see
+/// [`radiant_scene::reflectance_spectrum`]). Greys, and colours no smooth spectrum
+/// reaches, are returned as they are. A closed form of the smooth coat: roughness and the medium between are
+/// left out of the correction.
+pub fn spectrally_matched_base(reflectance: Rgb, eta: f32) -> Rgb {
+    let rgb = reflectance.to_array().map(|c| c as f64);
+    if (rgb[0] - rgb[1]).abs() < 1e-6 && (rgb[1] - rgb[2]).abs() < 1e-6 {
+        return reflectance;
+    }
+    let Some(spectrum) = SmoothReflectance::fit(rgb) else {
+        return reflectance;
+    };
+    let r_i = internal_reflectance(eta) as f64;
+    let series = spectrum.project(|r| r / (1.0 - r * r_i));
+    // Inverse of t = r / (1 − r r_i).
+    let base = series.map(|t| {
+        let t = t.max(0.0);
+        (t / (1.0 + t * r_i)).clamp(0.0, 1.0) as f32
+    });
+    Rgb::from_array(base)
 }
 
 /// Hemispherical (cosine-weighted) reflectance of a smooth interface seen from inside

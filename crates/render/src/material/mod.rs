@@ -81,6 +81,20 @@ pub struct BsdfSample {
     pub specular: bool,
 }
 
+/// `desc` as an RGB renderer must take it to agree with spectral transport where a
+/// reflectance enters non-linearly: a coated diffuse base by
+/// [`layered::spectrally_matched_base`]; every other material as it is. For materials
+/// given by constants (textured ones are evaluated per hit, uncorrected).
+pub fn spectrally_matched(desc: &MaterialDesc) -> MaterialDesc {
+    match desc {
+        MaterialDesc::CoatedDiffuse { reflectance, coat } => MaterialDesc::CoatedDiffuse {
+            reflectance: layered::spectrally_matched_base(*reflectance, coat.eta),
+            coat: *coat,
+        },
+        d => d.clone(),
+    }
+}
+
 impl Material {
     pub fn from_desc(desc: &MaterialDesc) -> Material {
         match desc {

@@ -19,7 +19,7 @@ use crate::light::{
     LIGHT_SAMPLER_NAMES, LIGHT_SAMPLER_PARAM, Light, LightSampler, LightShape, ProjectionLight,
     SceneSphere, parallelogram_of, rotation_of,
 };
-use crate::material::Material;
+use crate::material::{Material, spectrally_matched};
 use crate::texture::{TextureSet, concrete_material};
 use radiant_math::Transform;
 use radiant_math::color::Rgb;
@@ -497,7 +497,7 @@ fn material_table(
                 },
             },
             MaterialDesc::Textured(t) => MaterialEntry::Bsdf(representative(t, textures)),
-            d => MaterialEntry::Bsdf(Material::from_desc(d)),
+            d => MaterialEntry::Bsdf(Material::from_desc(&spectrally_matched(d))),
         })
         .collect();
     let refuse = |msg: String| SceneError::at(&FileLoc::builtin("materials"), msg);
