@@ -4,6 +4,10 @@ use radiant_scene::{IntegratorDesc, SceneError};
 
 /// Settings of stochastic progressive photon mapping. The number of iterations is the
 /// sampler's `pixelsamples` (as in pbrt-v4).
+///
+/// The defaults were checked by time to error on cornell-caustics (docs/speed.md): a
+/// smaller radius with more photons reaches a caustic's error sooner, a larger one the
+/// diffuse interreflection's; none of the settings tried wins both.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SppmSettings {
     /// `"float radius"` (scene units): the initial gather radius of every pixel.
