@@ -4,7 +4,9 @@
 
 use super::build::{BuildSettings, build_binary, collapse};
 use super::node::{NodeRay, decode_leaf, encode_leaf};
-use super::traverse::{self, AnyLeaf, ClosestLeaf, LARGE_STACK, NodeTree, SMALL_STACK};
+use super::traverse::{
+    self, AnyLeaf, ClosestLeaf, LARGE_STACK, NodeTree, SMALL_STACK, StackSize, TINY_STACK,
+};
 use crate::geometry::{Aabb, Ray};
 
 /// An 8-wide BVH over caller-owned primitives given by their bounding boxes.
@@ -89,10 +91,10 @@ impl Bvh {
         t_max: f32,
         intersect_prim: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<f32> {
-        if self.nodes.shallow() {
-            self.closest_with::<SMALL_STACK>(ray, t_max, intersect_prim)
-        } else {
-            self.closest_with::<LARGE_STACK>(ray, t_max, intersect_prim)
+        match self.nodes.stack() {
+            StackSize::Tiny => self.closest_with::<TINY_STACK>(ray, t_max, intersect_prim),
+            StackSize::Small => self.closest_with::<SMALL_STACK>(ray, t_max, intersect_prim),
+            StackSize::Large => self.closest_with::<LARGE_STACK>(ray, t_max, intersect_prim),
         }
     }
 
@@ -118,10 +120,10 @@ impl Bvh {
     /// `occludes(prim_index, t_max)` returns true.
     #[inline]
     pub fn any_hit(&self, ray: &Ray, t_max: f32, occludes: impl FnMut(u32, f32) -> bool) -> bool {
-        if self.nodes.shallow() {
-            self.any_with::<SMALL_STACK>(ray, t_max, occludes)
-        } else {
-            self.any_with::<LARGE_STACK>(ray, t_max, occludes)
+        match self.nodes.stack() {
+            StackSize::Tiny => self.any_with::<TINY_STACK>(ray, t_max, occludes),
+            StackSize::Small => self.any_with::<SMALL_STACK>(ray, t_max, occludes),
+            StackSize::Large => self.any_with::<LARGE_STACK>(ray, t_max, occludes),
         }
     }
 
@@ -166,7 +168,7 @@ impl Bvh {
 
     #[cfg(test)]
     pub(crate) fn nodes_are_shallow(&self) -> bool {
-        self.nodes.shallow()
+        self.nodes.stack() != StackSize::Large
     }
 
     /// A tree from hand-made nodes (tests of the traversal's limits).

@@ -16,12 +16,25 @@ pub(crate) const LARGE_STACK: usize = (WIDTH - 1) * MAX_DEPTH as usize + 4;
 /// and zeroing the large stack for every ray costs measurably (~10 % on shadow rays).
 pub(crate) const SMALL_STACK: usize = 96;
 const SMALL_STACK_DEPTH: u32 = (SMALL_STACK as u32 - 1) / (WIDTH as u32 - 1);
+/// The stack for trees of at most five levels (small scenes such as the Cornell box):
+/// even the small stack's zeroing was 3 % of a path-traced sample there.
+pub(crate) const TINY_STACK: usize = 36;
+const TINY_STACK_DEPTH: u32 = (TINY_STACK as u32 - 1) / (WIDTH as u32 - 1);
 
-/// The flattened wide nodes (node 0 is the root) and whether the small stack suffices.
+/// Which traversal stack a tree needs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) enum StackSize {
+    #[default]
+    Tiny,
+    Small,
+    Large,
+}
+
+/// The flattened wide nodes (node 0 is the root) and the stack they need.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct NodeTree {
     nodes: Vec<WideNode>,
-    shallow: bool,
+    stack: StackSize,
 }
 
 impl NodeTree {
@@ -37,10 +50,14 @@ impl NodeTree {
             }
         }
         let depth = level.iter().copied().max().unwrap_or(0);
-        NodeTree {
-            nodes,
-            shallow: depth <= SMALL_STACK_DEPTH,
-        }
+        let stack = if depth <= TINY_STACK_DEPTH {
+            StackSize::Tiny
+        } else if depth <= SMALL_STACK_DEPTH {
+            StackSize::Small
+        } else {
+            StackSize::Large
+        };
+        NodeTree { nodes, stack }
     }
 
     pub fn len(&self) -> usize {
@@ -51,10 +68,10 @@ impl NodeTree {
         &self.nodes
     }
 
-    /// Whether [`SMALL_STACK`] entries suffice. Callers dispatch on this once per query to
-    /// a monomorphised traversal (doing it here would keep the leaf closures from inlining).
-    pub fn shallow(&self) -> bool {
-        self.shallow
+    /// The stack the tree needs. Callers dispatch on this once per query to a
+    /// monomorphised traversal (doing it here would keep the leaf closures from inlining).
+    pub fn stack(&self) -> StackSize {
+        self.stack
     }
 }
 

@@ -4,7 +4,9 @@
 
 use super::build::{BuildSettings, build_binary, collapse};
 use super::node::{MAX_LEAF_ITEMS, NodeRay, decode_leaf, encode_leaf};
-use super::traverse::{self, AnyLeaf, ClosestLeaf, LARGE_STACK, NodeTree, SMALL_STACK};
+use super::traverse::{
+    self, AnyLeaf, ClosestLeaf, LARGE_STACK, NodeTree, SMALL_STACK, StackSize, TINY_STACK,
+};
 use super::triangle4::{Triangle4, WatertightRay4, intersect4};
 use crate::geometry::triangle::WatertightRay;
 use crate::geometry::{Aabb, Ray};
@@ -109,10 +111,10 @@ impl TriangleBvh {
     /// Closest hit with 0 < t < t_max (watertight, two-sided).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<MeshHit> {
-        if self.nodes.shallow() {
-            self.intersect_with::<SMALL_STACK>(ray, t_max)
-        } else {
-            self.intersect_with::<LARGE_STACK>(ray, t_max)
+        match self.nodes.stack() {
+            StackSize::Tiny => self.intersect_with::<TINY_STACK>(ray, t_max),
+            StackSize::Small => self.intersect_with::<SMALL_STACK>(ray, t_max),
+            StackSize::Large => self.intersect_with::<LARGE_STACK>(ray, t_max),
         }
     }
 
@@ -199,10 +201,10 @@ impl TriangleBvh {
     /// Whether anything is hit with 0 < t < t_max.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        if self.nodes.shallow() {
-            self.occluded_with::<SMALL_STACK>(ray, t_max)
-        } else {
-            self.occluded_with::<LARGE_STACK>(ray, t_max)
+        match self.nodes.stack() {
+            StackSize::Tiny => self.occluded_with::<TINY_STACK>(ray, t_max),
+            StackSize::Small => self.occluded_with::<SMALL_STACK>(ray, t_max),
+            StackSize::Large => self.occluded_with::<LARGE_STACK>(ray, t_max),
         }
     }
 

@@ -128,9 +128,10 @@ impl SurfacePoint {
 }
 
 /// `p` moved along `n` (to the side of `w`) past its error box `p_error`, then rounded one
-/// ulp further away from the surface in every moved component. Inlined: every bounce
-/// and shadow ray starts here, and the profile showed the call's own overhead.
-#[inline]
+/// ulp further away from the surface in every moved component. Always inlined: every
+/// bounce and shadow ray starts here, and as a call its vector arguments went through
+/// memory, where reading them back stalled on the stores that had just written them.
+#[inline(always)]
 pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     // The box's half-extent along n, |n|·p_error: raised by γ₄ for the rounding of this
     // dot product and for a unit normal whose computed length falls a few ulps short of 1

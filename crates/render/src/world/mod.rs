@@ -282,7 +282,18 @@ impl World {
 
     /// The entry a mix chain starting at `index` chooses at `p` seen from `wo_world`;
     /// textured amounts are evaluated at `hit`, or at their mean without one.
-    fn resolve_index(
+    fn resolve_index(&self, index: u32, p: Vec3, wo_world: Vec3, hit: Option<&SurfaceHit>) -> u32 {
+        match self.materials[index as usize] {
+            MaterialEntry::Bsdf(_) => index,
+            MaterialEntry::Mix { .. } => self.resolve_mix(index, p, wo_world, hit),
+        }
+    }
+
+    /// [`resolve_index`](Self::resolve_index) for a mix. Apart and not inlined: the
+    /// hash of (p, wo) does not change along the chain, and inlined the compiler
+    /// hoists it ahead of the entry test, hashing at every hit of a plain material.
+    #[inline(never)]
+    fn resolve_mix(
         &self,
         mut index: u32,
         p: Vec3,
