@@ -167,8 +167,8 @@ impl Bvh {
     }
 
     #[cfg(test)]
-    pub(crate) fn nodes_are_shallow(&self) -> bool {
-        self.nodes.stack() != StackSize::Large
+    pub(crate) fn stack_size(&self) -> StackSize {
+        self.nodes.stack()
     }
 
     /// A tree from hand-made nodes (tests of the traversal's limits).

@@ -280,15 +280,29 @@ fn empty_and_degenerate_inputs() {
 }
 
 #[test]
-fn deep_trees_use_the_large_stack_and_stay_exact() {
-    // A hand-made worst case for the traversal stack: a chain of 30 wide nodes whose boxes
-    // all enclose the whole scene, each with one inner child and WIDTH − 1 leaves, so a ray
-    // pushes WIDTH − 1 entries per level. The small stack would overflow; the tree must be
-    // recognised as deep and still answer exactly.
+fn every_stack_size_holds_its_deepest_tree_exactly() {
+    // The deepest trees each stack accepts, and one level more: a stack one entry short
+    // of the bound would drop pending subtrees and miss hits here.
+    use super::traverse::StackSize;
+    for (levels, stack) in [
+        (5, StackSize::Tiny),
+        (6, StackSize::Small),
+        (13, StackSize::Small),
+        (14, StackSize::Large),
+        (30, StackSize::Large),
+    ] {
+        worst_case_chain_is_exact(levels, stack);
+    }
+}
+
+/// A hand-made worst case for the traversal stack: a chain of `levels` wide nodes whose
+/// boxes all enclose the whole scene, each with one inner child and WIDTH − 1 leaves, so
+/// a ray pushes WIDTH − 1 entries per level. The tree must get the stack `stack` and
+/// answer exactly (against brute force) for closest and any hits.
+fn worst_case_chain_is_exact(levels: usize, stack: super::traverse::StackSize) {
     use super::node::{WIDTH, WideNode, encode_leaf};
-    let levels = 30;
     let per_level = WIDTH - 1;
-    let mut rng = Pcg32::new(77, 1);
+    let mut rng = Pcg32::new(77, levels as u64);
     let spheres: Vec<(Vec3, f32)> = (0..levels * per_level)
         .map(|_| (rv(&mut rng), 0.02 + 0.05 * rng.uniform()))
         .collect();
@@ -307,7 +321,7 @@ fn deep_trees_use_the_large_stack_and_stay_exact() {
         .collect();
     let order: Vec<u32> = (0..spheres.len() as u32).collect();
     let bvh = Bvh::from_parts(nodes, order, all);
-    assert!(!bvh.nodes_are_shallow());
+    assert_eq!(bvh.stack_size(), stack, "{levels} levels");
     let hit = |i: u32, ray: &Ray, t_max: f32| {
         let (c, r) = spheres[i as usize];
         Sphere::full(r)
@@ -316,7 +330,7 @@ fn deep_trees_use_the_large_stack_and_stay_exact() {
             .map(|h| h.t)
     };
     let mut hits = 0;
-    for _ in 0..500 {
+    for _ in 0..2000 {
         let o = Vec3::new(-0.5, rng.uniform(), rng.uniform());
         let ray = Ray::new(o, rv(&mut rng) - o);
         let brute = (0..spheres.len() as u32)
@@ -341,5 +355,5 @@ fn deep_trees_use_the_large_stack_and_stay_exact() {
         }
         hits += usize::from(brute.is_some());
     }
-    assert!(hits > 100, "{hits}");
+    assert!(hits > 100, "{levels} levels: {hits}");
 }
