@@ -180,7 +180,7 @@ pub fn radiance(
         let wo = frame.to_local(wo_world);
 
         // Drawn for every vertex so that the dimension layout does not depend on the material.
-        let u_choice = sampler.get_1d();
+        let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
         let u_light = sampler.get_2d();
         if !material.is_specular() {
             let at = direct::ShadingPoint::new(&hit, material, wo_world).with_mis();
@@ -221,9 +221,10 @@ pub fn radiance(
         prev_ctx = hit.light_sample_context().with_mis();
         ray = hit.spawn_ray(wi);
 
-        let u_rr = sampler.get_1d();
+        let roulette = depth > settings.rr_depth;
+        let u_rr = sampler.get_1d_if(roulette);
         let rr_beta = beta.max_component() * eta_scale;
-        if depth > settings.rr_depth && rr_beta < 1.0 {
+        if roulette && rr_beta < 1.0 {
             let q = (1.0 - rr_beta).max(0.0);
             if u_rr < q {
                 break;

@@ -144,7 +144,7 @@ pub fn glossy_direct(
     wo_world: Vec3,
     sampler: &mut PixelSample,
 ) -> (Rgb, u32) {
-    let u_choice = sampler.get_1d();
+    let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
     let u_light = sampler.get_2d();
     let at = ShadingPoint::new(hit, material, wo_world).with_mis();
     let ds = sample_direct(world, scene, &at, u_choice, u_light);

@@ -96,6 +96,16 @@ impl LightSampler {
         }
     }
 
+    /// Whether [`sample`](Self::sample) reads its number: not with one light or none,
+    /// which is always the choice (or no choice).
+    pub fn uses_choice_sample(&self) -> bool {
+        let count = match self {
+            LightSampler::Power { distribution } => distribution.len(),
+            LightSampler::Tree { emission, .. } => emission.len(),
+        };
+        count > 1
+    }
+
     /// Probability that `sample` from `ctx` picks light `index`.
     pub fn pmf(&self, ctx: &LightSampleContext, index: usize) -> f32 {
         match self {

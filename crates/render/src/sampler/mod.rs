@@ -103,6 +103,20 @@ impl PixelSample {
         }
     }
 
+    /// [`get_1d`](Self::get_1d) when `needed`; otherwise 0 without computing the number.
+    /// The dimension is consumed either way, so the dimensions that follow do not depend
+    /// on whether this one was used (a hashed Sobol value costs about a tenth of a
+    /// diffuse bounce's shading, and roulette and single-light choices skip most).
+    #[inline]
+    pub fn get_1d_if(&mut self, needed: bool) -> f32 {
+        if needed {
+            self.get_1d()
+        } else {
+            self.dim += 1;
+            0.0
+        }
+    }
+
     /// A pair of uniform numbers in [0, 1)^2, stratified together.
     pub fn get_2d(&mut self) -> Vec2 {
         let dim = self.dim;

@@ -129,7 +129,7 @@ pub fn radiance(
         let reflected = match settings.visualize {
             Visualize::None => {
                 l += beta * emitted;
-                let u_choice = sampler.get_1d();
+                let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
                 let u_light = sampler.get_2d();
                 let at = ShadingPoint::new(&hit, material, wo_world);
                 let direct = sample_direct(world, ctx.scene, &at, u_choice, u_light);
@@ -221,7 +221,7 @@ fn final_gather(
                 ray = y.spawn_ray(wi);
                 continue;
             }
-            let u_choice = s.get_1d();
+            let u_choice = s.get_1d_if(world.light_sampler.uses_choice_sample());
             let u_light = s.get_2d();
             let at_y = ShadingPoint::new(&y, mat_y, wo_y_world);
             let direct = sample_direct(world, ctx.scene, &at_y, u_choice, u_light);

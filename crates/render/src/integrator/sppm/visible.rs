@@ -112,7 +112,7 @@ pub fn camera_sample(
             ray = hit.spawn_ray(wi);
             continue;
         }
-        let u_choice = sampler.get_1d();
+        let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
         let u_light = sampler.get_2d();
         let at = ShadingPoint::new(&hit, material, wo_world);
         let direct = sample_direct(world, scene, &at, u_choice, u_light);
