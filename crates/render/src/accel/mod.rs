@@ -7,6 +7,9 @@
 //!   inline with the watertight test — the fast path.
 //! - [`ray_benchmark`]: the Mrays/s benchmark behind `radiant bench` and `benches/rays.rs`.
 
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod avx;
 mod bench;
 mod build;
 mod bvh;

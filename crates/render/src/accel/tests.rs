@@ -117,6 +117,47 @@ fn triangle_bvh_and_generic_bvh_equal_brute_force() {
     assert!(checked_hits > 4500, "{checked_hits}");
 }
 
+/// The 8-lane AVX kernels and the 4-lane ones must report the same hit, bit for bit
+/// (distance, triangle on ties, barycentrics), and the same occlusion: on the edge-case
+/// soups, where rays run through edges, vertices and face planes, and on a closed mesh.
+#[test]
+fn avx_and_sse_kernels_give_identical_hits() {
+    let mut rng = Pcg32::new(11, 5);
+    let mut scenes: Vec<Vec<[Vec3; 3]>> = [3usize, 9, 36, 500, 4000]
+        .into_iter()
+        .map(|n| soup(&mut rng, n))
+        .collect();
+    let sphere = geodesic_sphere(20);
+    scenes.push(
+        sphere
+            .triangles
+            .iter()
+            .map(|t| t.map(|i| sphere.vertices[i as usize]))
+            .collect(),
+    );
+    let mut hits = 0;
+    for tris in &scenes {
+        let wide = TriangleBvh::from_soup(tris);
+        let narrow = wide.clone().without_avx();
+        assert!(!narrow.uses_avx());
+        let mut queries = rays(&mut rng, tris, 3000);
+        // Rays from inside the sphere too, so that closest hits lie behind other leaves.
+        queries.extend((0..500).map(|_| Ray::new((rv(&mut rng) - 0.5) * 0.5, rv(&mut rng) - 0.5)));
+        for ray in &queries {
+            for t_max in [f32::INFINITY, 3.0, 0.5] {
+                let (a, b) = (wide.intersect(ray, t_max), narrow.intersect(ray, t_max));
+                assert_eq!(a, b, "{ray:?} t_max {t_max}");
+                hits += usize::from(a.is_some());
+                assert_eq!(wide.occluded(ray, t_max), narrow.occluded(ray, t_max));
+            }
+        }
+    }
+    assert!(hits > 10_000, "{hits}");
+    if !TriangleBvh::from_soup(&scenes[0]).uses_avx() {
+        eprintln!("this processor has no AVX: only the 4-lane kernels were compared");
+    }
+}
+
 #[test]
 fn closed_mesh_does_not_leak_through_the_bvh() {
     // The watertight test survives the box culling (Ize's conservative exit distance):

@@ -75,6 +75,25 @@ impl NodeTree {
     }
 }
 
+/// The box test of a wide node for one ray: the mask of the children it enters within
+/// `[0, t_max]` and their entry distances. Implemented by the 4-lane test and, where the
+/// processor has it, the 8-lane AVX one (which give the same bits).
+pub(crate) trait NodeTest {
+    fn hit(&self, node: &WideNode, t_max: f32) -> (u32, [f32; WIDTH]);
+}
+
+impl NodeTest for NodeRay {
+    #[inline(always)]
+    fn hit(&self, node: &WideNode, t_max: f32) -> (u32, [f32; WIDTH]) {
+        let (mask, t_in) = NodeRay::hit(self, node, t_max);
+        let mut t = [0.0f32; WIDTH];
+        for (g, v) in t_in.iter().enumerate() {
+            t[4 * g..4 * g + 4].copy_from_slice(&v.to_array());
+        }
+        (mask, t)
+    }
+}
+
 /// What closest-hit traversal does at a leaf: intersect its primitives with hits closer
 /// than `t_max`, and return the new (smaller) `t_max` if there was one. A trait with
 /// `#[inline(always)]` implementations rather than a closure, because LLVM declines to
@@ -125,7 +144,7 @@ struct Entry {
 #[inline(always)]
 pub(crate) fn closest<const STACK_SIZE: usize>(
     nodes: &[WideNode],
-    ray: &NodeRay,
+    ray: &impl NodeTest,
     mut t_max: f32,
     leaf: &mut impl ClosestLeaf,
 ) -> f32 {
@@ -138,13 +157,9 @@ pub(crate) fn closest<const STACK_SIZE: usize>(
     loop {
         if cur & LEAF_BIT == 0 {
             let node = &nodes[cur as usize];
-            let (mut mask, t_in) = ray.hit(node, t_max);
+            let (mut mask, t) = ray.hit(node, t_max);
             if mask != 0 {
                 touch_children(nodes, node, mask, |c| leaf.touch(c));
-                let mut t = [0.0f32; WIDTH];
-                for (g, v) in t_in.iter().enumerate() {
-                    t[4 * g..4 * g + 4].copy_from_slice(&v.to_array());
-                }
                 let i0 = mask.trailing_zeros() as usize % WIDTH;
                 mask &= mask - 1;
                 if mask == 0 {
@@ -221,7 +236,7 @@ pub(crate) fn closest<const STACK_SIZE: usize>(
 #[inline(always)]
 pub(crate) fn any<const STACK_SIZE: usize>(
     nodes: &[WideNode],
-    ray: &NodeRay,
+    ray: &impl NodeTest,
     t_max: f32,
     leaf: &mut impl AnyLeaf,
 ) -> bool {

@@ -2,6 +2,8 @@
 //! blocks ([`Triangle4`]), intersected inline during traversal with no callback. This is
 //! the hot path of the renderer.
 
+#[cfg(target_arch = "x86_64")]
+use super::avx::{Avx, NodeRay8, WatertightRay8};
 use super::build::{BuildSettings, build_binary, collapse};
 use super::node::{MAX_LEAF_ITEMS, NodeRay, decode_leaf, encode_leaf};
 use super::traverse::{
@@ -31,6 +33,10 @@ pub struct TriangleBvh {
     packet_prims: Vec<[u32; 4]>,
     order: Vec<u32>,
     bounds: Aabb,
+    /// Set when the processor has AVX: queries then test eight boxes and eight triangles
+    /// at once (the same hits, bit for bit).
+    #[cfg(target_arch = "x86_64")]
+    avx: Option<Avx>,
 }
 
 /// SAH costs in units of one 4-triangle block test, a binary build node charged the same;
@@ -96,7 +102,27 @@ impl TriangleBvh {
             packet_prims,
             order,
             bounds,
+            #[cfg(target_arch = "x86_64")]
+            avx: Avx::detect(),
         }
+    }
+
+    /// The same tree queried with the 4-lane kernels only (for tests that compare them).
+    #[cfg(test)]
+    pub(crate) fn without_avx(self) -> TriangleBvh {
+        TriangleBvh {
+            #[cfg(target_arch = "x86_64")]
+            avx: None,
+            ..self
+        }
+    }
+
+    /// Whether queries use the 8-lane AVX kernels.
+    pub fn uses_avx(&self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        return self.avx.is_some();
+        #[cfg(not(target_arch = "x86_64"))]
+        return false;
     }
 
     /// Builds from a triangle soup (three corners per triangle).
@@ -111,6 +137,16 @@ impl TriangleBvh {
     /// Closest hit with 0 < t < t_max (watertight, two-sided).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<MeshHit> {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(avx) = self.avx {
+            // SAFETY: `avx` proves that this processor runs AVX code.
+            #[allow(unsafe_code)]
+            return match self.nodes.stack() {
+                StackSize::Tiny => unsafe { self.intersect_avx::<TINY_STACK>(avx, ray, t_max) },
+                StackSize::Small => unsafe { self.intersect_avx::<SMALL_STACK>(avx, ray, t_max) },
+                StackSize::Large => unsafe { self.intersect_avx::<LARGE_STACK>(avx, ray, t_max) },
+            };
+        }
         match self.nodes.stack() {
             StackSize::Tiny => self.intersect_with::<TINY_STACK>(ray, t_max),
             StackSize::Small => self.intersect_with::<SMALL_STACK>(ray, t_max),
@@ -133,6 +169,127 @@ impl TriangleBvh {
             prim: self.packet_prims[h.block as usize][h.lane as usize & 3],
             b: h.b,
         })
+    }
+
+    /// [`intersect_with`](Self::intersect_with) with the 8-lane tests, compiled for AVX
+    /// (with everything it inlines: no closure may carry the kernels, as closures are
+    /// not compiled for their caller's features).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn intersect_avx<const STACK: usize>(
+        &self,
+        avx: Avx,
+        ray: &Ray,
+        t_max: f32,
+    ) -> Option<MeshHit> {
+        let wr = WatertightRay8::new(&WatertightRay::new(ray), avx);
+        let mut best: Option<BlockHit> = None;
+        let mut leaves = ClosestBlocks8 {
+            bvh: self,
+            ray: &wr,
+            best: &mut best,
+        };
+        traverse::closest::<STACK>(
+            self.nodes.nodes(),
+            &NodeRay8::new(ray, avx),
+            t_max,
+            &mut leaves,
+        );
+        best.map(|h| MeshHit {
+            t: h.t,
+            prim: self.packet_prims[h.block as usize][h.lane as usize & 3],
+            b: h.b,
+        })
+    }
+
+    /// [`leaf_closest`](Self::leaf_closest) with the leaf's blocks tested two at a time (an
+    /// odd last block is paired with itself and its copy's lanes ignored). The nearest of
+    /// the eight lanes, the lower lane on a tie, is what testing the two blocks in turn
+    /// finds, so both kernels record the same hit.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn leaf_closest8(
+        &self,
+        wr: &WatertightRay8,
+        leaf: u32,
+        mut t_max: f32,
+        best: &mut Option<BlockHit>,
+    ) -> Option<f32> {
+        let (start, count) = decode_leaf(leaf);
+        let blocks = &self.packets[start..start + count];
+        let mut hit = false;
+        for (pair, chunk) in blocks.chunks(2).enumerate() {
+            let (a, b, valid) = match chunk {
+                [a, b] => (a, b, 0xff),
+                [a] => (a, a, 0x0f),
+                _ => continue,
+            };
+            let lanes = wr.intersect(a, b, t_max);
+            let lanes_hit = lanes.hit & valid;
+            if lanes_hit == 0 {
+                continue;
+            }
+            let t = lanes.t;
+            let mut lane = lanes_hit.trailing_zeros() as usize;
+            let mut rest = lanes_hit & (lanes_hit - 1);
+            while rest != 0 {
+                let l = rest.trailing_zeros() as usize;
+                if t[l & 7] < t[lane & 7] {
+                    lane = l;
+                }
+                rest &= rest - 1;
+            }
+            let lane = lane & 7;
+            let inv = 1.0 / lanes.det[lane];
+            t_max = t[lane];
+            hit = true;
+            *best = Some(BlockHit {
+                t: t_max,
+                block: (start + 2 * pair + lane / 4) as u32,
+                lane: (lane % 4) as u32,
+                b: [
+                    lanes.u[lane] * inv,
+                    lanes.v[lane] * inv,
+                    lanes.w[lane] * inv,
+                ],
+            });
+        }
+        hit.then_some(t_max)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn leaf_occluded8(&self, wr: &WatertightRay8, leaf: u32, t_max: f32) -> bool {
+        let (start, count) = decode_leaf(leaf);
+        // A loop, not `any` with a closure: closures are not compiled for AVX.
+        for chunk in self.packets[start..start + count].chunks(2) {
+            let hit = match chunk {
+                [a, b] => wr.intersect(a, b, t_max).hit,
+                [a] => wr.intersect(a, a, t_max).hit & 0x0f,
+                _ => 0,
+            };
+            if hit != 0 {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// [`occluded_with`](Self::occluded_with) with the 8-lane tests, compiled for AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn occluded_avx<const STACK: usize>(&self, avx: Avx, ray: &Ray, t_max: f32) -> bool {
+        let wr = WatertightRay8::new(&WatertightRay::new(ray), avx);
+        let mut leaves = AnyBlock8 {
+            bvh: self,
+            ray: &wr,
+        };
+        traverse::any::<STACK>(
+            self.nodes.nodes(),
+            &NodeRay8::new(ray, avx),
+            t_max,
+            &mut leaves,
+        )
     }
 
     /// Intersects a leaf's blocks; records a closer hit in `best` and returns its distance.
@@ -201,6 +358,16 @@ impl TriangleBvh {
     /// Whether anything is hit with 0 < t < t_max.
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(avx) = self.avx {
+            // SAFETY: `avx` proves that this processor runs AVX code.
+            #[allow(unsafe_code)]
+            return match self.nodes.stack() {
+                StackSize::Tiny => unsafe { self.occluded_avx::<TINY_STACK>(avx, ray, t_max) },
+                StackSize::Small => unsafe { self.occluded_avx::<SMALL_STACK>(avx, ray, t_max) },
+                StackSize::Large => unsafe { self.occluded_avx::<LARGE_STACK>(avx, ray, t_max) },
+            };
+        }
         match self.nodes.stack() {
             StackSize::Tiny => self.occluded_with::<TINY_STACK>(ray, t_max),
             StackSize::Small => self.occluded_with::<SMALL_STACK>(ray, t_max),
@@ -274,6 +441,45 @@ impl AnyLeaf for AnyBlock<'_> {
     #[inline(always)]
     fn visit(&mut self, leaf: u32, t_max: f32) -> bool {
         self.bvh.leaf_occluded(self.ray, leaf, t_max)
+    }
+
+    #[inline(always)]
+    fn touch(&self, leaf: u32) {
+        self.bvh.touch_leaf(leaf);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+struct ClosestBlocks8<'a> {
+    bvh: &'a TriangleBvh,
+    ray: &'a WatertightRay8,
+    best: &'a mut Option<BlockHit>,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl ClosestLeaf for ClosestBlocks8<'_> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: u32, t_max: f32) -> Option<f32> {
+        self.bvh.leaf_closest8(self.ray, leaf, t_max, self.best)
+    }
+
+    #[inline(always)]
+    fn touch(&self, leaf: u32) {
+        self.bvh.touch_leaf(leaf);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+struct AnyBlock8<'a> {
+    bvh: &'a TriangleBvh,
+    ray: &'a WatertightRay8,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl AnyLeaf for AnyBlock8<'_> {
+    #[inline(always)]
+    fn visit(&mut self, leaf: u32, t_max: f32) -> bool {
+        self.bvh.leaf_occluded8(self.ray, leaf, t_max)
     }
 
     #[inline(always)]
