@@ -230,16 +230,7 @@ impl TriangleBvh {
                 continue;
             }
             let t = lanes.t;
-            let mut lane = lanes_hit.trailing_zeros() as usize;
-            let mut rest = lanes_hit & (lanes_hit - 1);
-            while rest != 0 {
-                let l = rest.trailing_zeros() as usize;
-                if t[l & 7] < t[lane & 7] {
-                    lane = l;
-                }
-                rest &= rest - 1;
-            }
-            let lane = lane & 7;
+            let lane = nearest_lane(lanes_hit, &t);
             let inv = 1.0 / lanes.det[lane];
             t_max = t[lane];
             hit = true;
@@ -309,16 +300,7 @@ impl TriangleBvh {
                 continue;
             }
             let t = lanes.t.to_array();
-            let mut lane = lanes.hit.trailing_zeros() as usize;
-            let mut rest = lanes.hit & (lanes.hit - 1);
-            while rest != 0 {
-                let l = rest.trailing_zeros() as usize;
-                if t[l & 3] < t[lane & 3] {
-                    lane = l;
-                }
-                rest &= rest - 1;
-            }
-            let lane = lane & 3;
+            let lane = nearest_lane(lanes.hit, &t);
             let inv = 1.0 / lanes.det[lane];
             t_max = t[lane];
             hit = true;
@@ -403,6 +385,22 @@ impl TriangleBvh {
     pub fn size(&self) -> (usize, usize) {
         (self.nodes.len(), self.packets.len())
     }
+}
+
+/// Of the lanes set in `hits` (not empty), the one with the smallest `t`, the lowest on
+/// a tie: the rule both kernels share, so that they pick the same triangle.
+#[inline(always)]
+fn nearest_lane<const N: usize>(hits: u32, t: &[f32; N]) -> usize {
+    let mut lane = hits.trailing_zeros() as usize % N;
+    let mut rest = hits & hits.wrapping_sub(1);
+    while rest != 0 {
+        let l = rest.trailing_zeros() as usize % N;
+        if t[l] < t[lane] {
+            lane = l;
+        }
+        rest &= rest - 1;
+    }
+    lane
 }
 
 /// The closest hit so far, by block and lane (the triangle index is looked up once, at the end).
