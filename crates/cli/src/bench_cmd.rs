@@ -213,7 +213,7 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
             reference: "cornell-caustics-256-ref.exr",
             crop: Some(caustic_crop),
             target: 4e-3,
-            max_spp: 256,
+            max_spp: 128,
         },
         Task {
             label: "cornell-caustics whole image, sppm, to 7.5e-4",
@@ -222,7 +222,7 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
             reference: "cornell-caustics-256-ref.exr",
             crop: None,
             target: 7.5e-4,
-            max_spp: 256,
+            max_spp: 128,
         },
     ];
     println!(

@@ -2,14 +2,14 @@
 //! disk, so that a run stopped by a signal or a time limit continues where it stopped
 //! and ends with the image an uninterrupted run makes, bit for bit.
 //!
-//! # Format (version 1)
+//! # Format (version 2)
 //!
 //! All numbers little-endian; floats are IEEE 754 bit patterns, so nothing is rounded.
 //!
 //! | bytes | content |
 //! |-------|---------|
 //! | 8     | magic `RADCKPT\n` |
-//! | 4     | format version, u32 (1) |
+//! | 4     | format version, u32 (2) |
 //! | 4     | header length H, u32 |
 //! | H     | header: UTF-8 text, one `key: value` per line |
 //! | 8     | payload length P, u64 |
@@ -29,7 +29,8 @@
 //!   weighted sums r, g, b (f64), the weight sum (f64) and the samples taken (u32) —
 //!   36 bytes a pixel. The samples are those of indices `0..samples`.
 //! - `sppm`: iterations u32, width u32, height u32; then per pixel the direct-light
-//!   sums (3 f64), τ (3 f64), N (f64) and R² (f64) — 64 bytes a pixel.
+//!   sums (3 f64), then the global and the caustic estimate, each τ (3 f64), N (f64)
+//!   and R² (f64) — 104 bytes a pixel. (Version 1 had one estimate, 64 bytes.)
 //! - `radiosity`: shots u64, patches u64, then emitted, absorbed, escaped, unshot power
 //!   and unshot magnitude per band (5 × 3 f64); then per patch the radiosity B, the
 //!   unshot radiosity ΔB and the irradiance H (3 × 3 f64).
@@ -45,12 +46,14 @@ use radiant_image::atomic::atomic_write;
 use radiant_image::{Film, FilmPixel, NonFinite};
 use radiant_radiosity::ProgressiveState;
 use radiant_render::RenderContext;
-use radiant_render::integrator::{IntegratorState, SppmPixel};
+use radiant_render::integrator::{IntegratorState, PhotonEstimate, SppmPixel};
 use radiant_scene::{IntegratorDesc, SceneDesc};
 use thiserror::Error;
 
 const MAGIC: &[u8; 8] = b"RADCKPT\n";
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
+/// Bytes of one SPPM pixel in the payload.
+const SPPM_PIXEL_BYTES: usize = 104;
 
 #[derive(Debug, Error)]
 pub enum CheckpointError {
@@ -314,14 +317,16 @@ fn encode_payload(state: &State) -> Vec<u8> {
             height,
             pixels,
         }) => {
-            out.reserve(12 + 64 * pixels.len());
+            out.reserve(12 + SPPM_PIXEL_BYTES * pixels.len());
             for v in [*iterations, *width, *height] {
                 out.extend_from_slice(&v.to_le_bytes());
             }
             for p in pixels {
                 put_f64s(&mut out, &p.ld);
-                put_f64s(&mut out, &p.tau);
-                put_f64s(&mut out, &[p.n, p.r2]);
+                for e in [&p.global, &p.caustic] {
+                    put_f64s(&mut out, &e.tau);
+                    put_f64s(&mut out, &[e.n, e.r2]);
+                }
             }
         }
         State::Radiosity(s) => {
@@ -531,14 +536,20 @@ fn decode_sppm(
     let iterations = p.u32("the iteration count")?;
     let width = p.u32("the width")?;
     let height = p.u32("the height")?;
-    let n = pixel_count(p, (width, height), resolution, 64)?;
+    let n = pixel_count(p, (width, height), resolution, SPPM_PIXEL_BYTES)?;
     let mut pixels = Vec::with_capacity(n);
-    for _ in 0..n {
-        pixels.push(SppmPixel {
-            ld: p.f64x3("a pixel")?,
+    let estimate = |p: &mut Reader<'_>| -> Result<PhotonEstimate, CheckpointError> {
+        Ok(PhotonEstimate {
             tau: p.f64x3("a pixel")?,
             n: p.f64("a pixel")?,
             r2: p.f64("a pixel")?,
+        })
+    };
+    for _ in 0..n {
+        pixels.push(SppmPixel {
+            ld: p.f64x3("a pixel")?,
+            global: estimate(p)?,
+            caustic: estimate(p)?,
         });
     }
     Ok(IntegratorState::Sppm {

@@ -523,9 +523,9 @@ const T14: f64 = 5.36;
 /// tilted by 2 asin(d/2R), lies beyond that plane with probability (1 − cos)/2 =
 /// d²/(4R²). Over the disc (a cap of chord radius r has area πr² exactly) that loses
 /// r²/(8R²) of the photons' light Kd (L − Le), at most `curvature_loss` at the initial
-/// radius r₀: 0.1 to 0.2 % of L here, where the default r₀ (two pixel footprints at
-/// the bounding radius √3 R, the camera being near the centre) is 0.25 to 0.33 R. The
-/// expected mean lies in [L − that, L].
+/// radius r₀ (the default r₀ is a few pixel footprints at the bounding radius √3 R,
+/// the camera being near the centre; the bound is computed from the r₀ the render
+/// reports). The expected mean lies in [L − that, L].
 ///
 /// The pixels share photons, so the pixel spread understates the noise of the image
 /// mean (2 to 4 times here); the noise is measured instead from `SPPM_SEEDS`

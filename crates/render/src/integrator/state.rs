@@ -11,18 +11,28 @@ use std::ops::ControlFlow;
 
 use radiant_image::Film;
 
-/// A pixel's SPPM statistics after some iterations (Hachisuka & Jensen 2009): f64 sums,
+/// One progressive photon estimate of a pixel (Hachisuka & Jensen 2009): f64 sums,
 /// since thousands of iterations are accumulated.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct SppmPixel {
-    /// Sum of direct light over the iterations.
-    pub ld: [f64; 3],
+pub struct PhotonEstimate {
     /// Accumulated flux τ (times f and the camera throughput), rescaled with the radius.
     pub tau: [f64; 3],
     /// Accumulated photon count N.
     pub n: f64,
     /// Squared gather radius R².
     pub r2: f64,
+}
+
+/// A pixel's SPPM statistics after some iterations: the direct light's sum and two
+/// photon estimates, each with its own radius: `global` for photons that scattered
+/// off a non-specular surface before arriving, `caustic` for those that came through
+/// specular surfaces only.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SppmPixel {
+    /// Sum of direct light over the iterations.
+    pub ld: [f64; 3],
+    pub global: PhotonEstimate,
+    pub caustic: PhotonEstimate,
 }
 
 /// Which kind of state an integrator saves and resumes from.

@@ -65,6 +65,10 @@ pub struct Landing<'a> {
     pub specular_chain: bool,
     /// The first scattering event (at the first hit) was specular.
     pub first_specular: bool,
+    /// Earlier landings of this photon: 0 when every surface before this one lets
+    /// photons through (`Material::passes_photon_paths`), the surfaces projection
+    /// maps aim at.
+    pub landings: u32,
 }
 
 /// Samples a photon: a light by power (or by the projection maps' power aimed at
@@ -115,6 +119,7 @@ pub fn trace_photon(
 ) -> u32 {
     let mut specular_chain = true;
     let mut first_specular = false;
+    let mut landings = 0u32;
     let mut rays = 0u32;
     crate::stats::add(crate::stats::Counter::PhotonPaths, 1);
     for bounces in 0..max_depth {
@@ -134,10 +139,12 @@ pub fn trace_photon(
                 bounces,
                 specular_chain,
                 first_specular,
+                landings,
             };
             if !land(&landing) {
                 break;
             }
+            landings += 1;
         }
         let frame = World::shading_frame(&hit, &material);
         let wo = frame.to_local(wo_world);

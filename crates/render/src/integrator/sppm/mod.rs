@@ -12,10 +12,21 @@
 //! shrinks to zero while the photon count grows without bound, so bias and variance
 //! both vanish: the estimate is consistent.
 //!
+//! Caustics get an estimate of their own, as in Jensen's two photon maps (Jensen 1996,
+//! "Global Illumination using Photon Maps"): photons that reach a surface through
+//! specular (or photon-passing rough) surfaces only are traced in a separate pass,
+//! aimed at the specular objects by projection maps, and gathered with their own,
+//! smaller radius; the global pass then skips exactly those arrivals. The two sets of
+//! paths are disjoint and together are the single estimate's, and each estimate is
+//! SPPM's, so the sum is consistent. Why: a caustic is sharp and wants a small radius,
+//! the diffuse interreflection is smooth and wants many photons per pixel, a large one
+//! (docs/speed.md measures both); and aimed photons put the caustic's share of the
+//! work where the caustic is.
+//!
 //! Photon contributions are collected per chunk of photons and applied in chunk order,
 //! so images are bit-identical at any thread count.
 
-pub mod hashgrid;
+pub mod photongrid;
 pub mod settings;
 pub mod visible;
 
@@ -23,41 +34,68 @@ use std::fmt;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
-use glam::{Vec3, Vec4};
+use glam::Vec3;
 use rayon::prelude::*;
 
 pub use settings::SppmSettings;
 
 use super::footprint::pixel_footprint;
-use super::photon::trace::{PhotonPass, PhotonStream};
+use super::photon::projection::ProjectionMaps;
+use super::photon::trace::{Landing, PhotonPass, PhotonStream};
 use crate::context::RenderContext;
 use crate::integrator::{
-    Integrator, IntegratorState, RenderControl, RenderOutput, SppmPixel, StateKind, Stats,
+    Integrator, IntegratorState, PhotonEstimate, RenderControl, RenderOutput, SppmPixel, StateKind,
+    Stats,
 };
-use hashgrid::HashGrid;
+use photongrid::{Deposit, PhotonGrid};
 use radiant_image::{Film, FilmPixel, NonFinite};
 use radiant_math::PI;
 use radiant_math::color::Rgb;
-use visible::{CameraSample, camera_sample};
+use visible::{CameraSample, VisiblePoint, camera_sample, sees_sharp_direct_light};
 
 const SPPM_PASS: u64 = 0x5bb3;
+const SPPM_CAUSTIC_PASS: u64 = 0x5bb4;
+/// Seed offset of the extra direct-light camera samples of sharp pixels.
+const SHARP_SAMPLES_SEED: u64 = 0x5bb5_0000_0000;
 
-/// Pixel footprints in the default initial radius.
-pub const DEFAULT_RADIUS_PIXELS: f32 = 2.0;
+/// Pixel footprints in the default initial radius of the global estimate, at most
+/// [`GLOBAL_RADIUS_IMAGE_FRACTION`] of the image's larger side.
+pub const GLOBAL_RADIUS_PIXELS: f32 = 8.0;
+/// The largest default global radius as a share of the image: a wider blur shows as
+/// darkened corners and contact shadows long after the first iterations (measured on
+/// a 64 × 64 image, docs/speed.md).
+pub const GLOBAL_RADIUS_IMAGE_FRACTION: f32 = 1.0 / 32.0;
+/// Pixel footprints in the default initial radius of the caustic estimate.
+pub const CAUSTIC_RADIUS_PIXELS: f32 = 1.0;
+/// Aimed caustic photons per global photon, by default.
+pub const CAUSTIC_PHOTONS_PER_PHOTON: u64 = 2;
 
 /// What an SPPM render did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SppmStats {
     pub iterations: u32,
     pub photons_per_iteration: u64,
-    /// Initial radius (scene units).
+    /// Photons of the caustic pass per iteration (0: no separate caustic estimate).
+    pub caustic_photons_per_iteration: u64,
+    /// Initial radius of the global estimate (scene units).
     pub initial_radius: f32,
+    /// Initial radius of the caustic estimate (scene units).
+    pub initial_caustic_radius: f32,
     /// True when the radius was derived from the pixel footprint (no `radius` given).
     pub radius_derived: bool,
-    /// Root-mean-square radius over the pixels at the end.
+    /// Pixel footprints in the derived radius.
+    pub radius_pixels: f32,
+    /// Root-mean-square radius over the pixels at the end (global estimate).
     pub final_radius: f32,
+    /// Root-mean-square radius over the pixels at the end (caustic estimate).
+    pub final_caustic_radius: f32,
     pub camera_seconds: f64,
+    /// Both photon passes and the pixels' updates.
     pub photon_seconds: f64,
+    /// The caustic pass's share of `photon_seconds`.
+    pub caustic_seconds: f64,
+    /// Pixels whose direct light takes `sharpdirectsamples` samples per iteration.
+    pub sharp_pixels: u64,
     pub rays: u64,
 }
 
@@ -68,13 +106,34 @@ impl fmt::Display for SppmStats {
             "sppm: initial radius {:.4}{}, final rms radius {:.4}",
             self.initial_radius,
             if self.radius_derived {
-                format!(" ({DEFAULT_RADIUS_PIXELS} pixel footprints at the scene centre)")
+                format!(
+                    " ({} pixel footprints at the scene centre)",
+                    self.radius_pixels
+                )
             } else {
                 String::new()
             },
             self.final_radius
         )?;
-        let photons = self.iterations as u64 * self.photons_per_iteration;
+        if self.sharp_pixels > 0 {
+            writeln!(
+                f,
+                "sppm: {} pixels see mirrors, glass or emitters and take more direct-light samples",
+                self.sharp_pixels
+            )?;
+        }
+        if self.caustic_photons_per_iteration > 0 {
+            writeln!(
+                f,
+                "sppm: caustic estimate: {} aimed photons per iteration, initial radius {:.4}, final rms radius {:.4}; caustic passes {:.3} s",
+                self.caustic_photons_per_iteration,
+                self.initial_caustic_radius,
+                self.final_caustic_radius,
+                self.caustic_seconds
+            )?;
+        }
+        let photons = self.iterations as u64
+            * (self.photons_per_iteration + self.caustic_photons_per_iteration);
         write!(
             f,
             "sppm: {} iterations x {} photons; camera passes {:.3} s, photon passes {:.3} s ({:.2} M photons/s)",
@@ -90,13 +149,30 @@ impl fmt::Display for SppmStats {
 /// A pixel's progressive statistics (f64: thousands of iterations are summed).
 type PixelState = SppmPixel;
 
-/// The default initial radius: [`DEFAULT_RADIUS_PIXELS`] pixel footprints at the
-/// distance of the scene's centre (or 1/100 of the scene's radius without one).
+/// `pixels` pixel footprints at the distance of the scene's centre (or `pixels`/200 of
+/// the scene's radius without one): how default radii are set.
+pub fn footprint_radius(ctx: &RenderContext, pixels: f32) -> f32 {
+    pixel_footprint(&ctx.camera, ctx.resolution, &ctx.world).map_or(
+        0.005 * pixels * ctx.world.scene_sphere().radius,
+        |(w, _)| pixels * w,
+    )
+}
+
+/// The default initial radius of the global estimate: [`GLOBAL_RADIUS_PIXELS`] pixel
+/// footprints, fewer on small images.
 pub fn default_radius(ctx: &RenderContext) -> f32 {
-    pixel_footprint(&ctx.camera, ctx.resolution, &ctx.world)
-        .map_or(0.01 * ctx.world.scene_sphere().radius, |(w, _)| {
-            DEFAULT_RADIUS_PIXELS * w
-        })
+    footprint_radius(ctx, default_radius_pixels(ctx.resolution))
+}
+
+/// Pixel footprints of the default global radius at `resolution`.
+pub fn default_radius_pixels(resolution: (u32, u32)) -> f32 {
+    let side = resolution.0.max(resolution.1) as f32;
+    GLOBAL_RADIUS_PIXELS.min(GLOBAL_RADIUS_IMAGE_FRACTION * side)
+}
+
+/// The default initial radius of the caustic estimate.
+pub fn default_caustic_radius(ctx: &RenderContext) -> f32 {
+    footprint_radius(ctx, CAUSTIC_RADIUS_PIXELS)
 }
 
 /// `Integrator "sppm"`: `ctx.spp` iterations; snapshots after every power-of-two
@@ -136,14 +212,30 @@ fn render(
     let full_pixels = ctx.resolution.0 as u64 * ctx.resolution.1 as u64;
     let seed = settings.seed.unwrap_or(ctx.seed);
     let radius = settings.radius.unwrap_or_else(|| default_radius(ctx));
+    let caustic_radius = settings
+        .caustic_radius
+        .or(settings.radius)
+        .unwrap_or_else(|| default_caustic_radius(ctx));
     let n_photons = settings
         .photons_per_iteration
         .map_or(full_pixels, u64::from)
         .max(1);
+    let world = &ctx.world;
+    // Without specular objects there are no caustics to aim at: one estimate.
+    let wanted_caustic = settings
+        .caustic_photons_per_iteration
+        .map_or(CAUSTIC_PHOTONS_PER_PHOTON * n_photons, u64::from);
+    let maps = (wanted_caustic > 0)
+        .then(|| ProjectionMaps::build(world))
+        .flatten();
+    let n_caustic = if maps.is_some() { wanted_caustic } else { 0 };
     let mut stats = SppmStats {
         photons_per_iteration: n_photons,
+        caustic_photons_per_iteration: n_caustic,
         initial_radius: radius,
+        initial_caustic_radius: if n_caustic > 0 { caustic_radius } else { 0.0 },
         radius_derived: settings.radius.is_none(),
+        radius_pixels: default_radius_pixels(ctx.resolution),
         ..Default::default()
     };
     progress
@@ -156,25 +248,33 @@ fn render(
             height,
             pixels,
         }) if (width, height) == ctx.film_size() && pixels.len() == n_pix => (pixels, iterations),
-        _ => (
-            vec![
-                PixelState {
-                    r2: radius as f64 * radius as f64,
-                    ..Default::default()
-                };
-                n_pix
-            ],
-            0,
-        ),
+        _ => {
+            let start = |r: f32| PhotonEstimate {
+                r2: r as f64 * r as f64,
+                ..Default::default()
+            };
+            let pixel = PixelState {
+                global: start(radius),
+                caustic: start(caustic_radius),
+                ..Default::default()
+            };
+            (vec![pixel; n_pix], 0)
+        }
     };
     progress
         .done
         .fetch_add(first.min(ctx.spp) as u64 * n_pix as u64, Ordering::Relaxed);
     let mut samples = vec![CameraSample::default(); n_pix];
-    let mut spheres = vec![Vec4::ZERO; n_pix];
-    let mut phi = vec![Rgb::BLACK; n_pix];
-    let mut count = vec![0u32; n_pix];
-    let world = &ctx.world;
+    let sharp_samples = settings.sharp_direct_samples.max(1);
+    let sharp: Vec<bool> = if sharp_samples > 1 {
+        (0..n_pix)
+            .into_par_iter()
+            .map(|i| sees_sharp_direct_light(ctx, x0 + (i % w) as u32, y0 + (i / w) as u32))
+            .collect()
+    } else {
+        vec![false; n_pix]
+    };
+    stats.sharp_pixels = sharp.iter().filter(|&&b| b).count() as u64;
     let mut film = ctx.new_film();
     // Its pixels are progressive estimates, not means of samples: no sample variance.
     film.moments = None;
@@ -185,39 +285,71 @@ fn render(
         height: h as u32,
         pixels: state.to_vec(),
     };
+    let alpha = settings.alpha as f64;
     for it in first..ctx.spp {
         if progress.cancelled() {
             break;
         }
         let t0 = Instant::now();
         samples.par_iter_mut().enumerate().for_each(|(i, s)| {
-            *s = camera_sample(
-                ctx,
-                seed,
-                settings.max_depth,
-                x0 + (i % w) as u32,
-                y0 + (i / w) as u32,
-                it,
-            );
+            let (x, y) = (x0 + (i % w) as u32, y0 + (i / w) as u32);
+            *s = camera_sample(ctx, seed, settings.max_depth, x, y, it);
+            if sharp[i] {
+                // More samples of the direct light only, from a stream of their own:
+                // which pixels get them was fixed before any random number was drawn.
+                let extra = sharp_samples - 1;
+                let mut ld = s.ld;
+                for e in 0..extra {
+                    let index = it.wrapping_mul(extra).wrapping_add(e);
+                    let more = camera_sample(
+                        ctx,
+                        seed ^ SHARP_SAMPLES_SEED,
+                        settings.max_depth,
+                        x,
+                        y,
+                        index,
+                    );
+                    ld += more.ld;
+                    s.rays += more.rays;
+                }
+                s.ld = ld * (1.0 / sharp_samples as f32);
+            }
         });
         let camera_rays: u64 = samples.par_iter().map(|s| s.rays as u64).sum();
-        // Positions and squared radii side by side: the photon pass tests many
-        // candidates per hit and reads little else.
-        spheres
-            .par_iter_mut()
-            .zip(samples.par_iter().zip(state.par_iter()))
-            .for_each(|(sp, (s, st))| {
-                *sp = if s.vp.valid {
-                    s.vp.p.extend(st.r2 as f32)
-                } else {
-                    Vec4::new(0.0, 0.0, 0.0, -1.0)
-                };
-            });
-        let grid = HashGrid::build(&spheres);
         stats.camera_seconds += t0.elapsed().as_secs_f64();
 
         let t1 = Instant::now();
-        let (hits, photon_rays) = PhotonPass {
+        let mut photon_rays = 0;
+        let mut caustic_grid = PhotonGrid::default();
+        if let Some(maps) = &maps {
+            // Aimed photons count only where they arrive through specular surfaces;
+            // whatever they do after that is the global pass's.
+            let (deposits, rays) = PhotonPass {
+                world,
+                stream: PhotonStream::new(ctx.sampler, seed, &[SPPM_CAUSTIC_PASS, it as u64]),
+                photons: n_caustic,
+                emitted_of: 1.0,
+                projection: Some(maps),
+                max_depth: settings.max_depth,
+            }
+            .trace(
+                || progress.cancelled(),
+                |l, out: &mut Vec<Deposit>| {
+                    if l.bounces > 0 && l.landings == 0 {
+                        out.push(deposit(l));
+                    }
+                    false
+                },
+            );
+            photon_rays += rays;
+            caustic_grid = PhotonGrid::build(deposits, caustic_radius);
+            stats.caustic_seconds += t1.elapsed().as_secs_f64();
+        }
+        if progress.cancelled() {
+            break;
+        }
+        let split = n_caustic > 0;
+        let (deposits, rays) = PhotonPass {
             world,
             stream: PhotonStream::new(ctx.sampler, seed, &[SPPM_PASS, it as u64]),
             photons: n_photons,
@@ -227,59 +359,36 @@ fn render(
         }
         .trace(
             || progress.cancelled(),
-            |l, out: &mut Vec<(u32, Rgb)>| {
-                // Direct light is next-event estimation's: skip first hits.
-                if l.bounces == 0 {
-                    return true;
-                }
-                let p = l.hit.p;
-                for e in grid.candidates(p) {
-                    if (Vec3::from_array(e.centre) - p).length_squared() >= e.r2 {
-                        continue;
-                    }
-                    let j = e.index;
-                    let vp = &samples[j as usize].vp;
-                    // Photons from behind count only where the BSDF transmits diffusely.
-                    if l.wi.dot(vp.n) <= 0.0 && !vp.material.transmits_diffusely() {
-                        continue;
-                    }
-                    let f = vp.material.eval(vp.wo, vp.frame.to_local(l.wi));
-                    if !f.is_black() {
-                        out.push((j, l.power * f));
-                    }
+            |l, out: &mut Vec<Deposit>| {
+                // Direct light is next-event estimation's: skip first hits; caustics
+                // are the caustic pass's when there is one.
+                if l.bounces > 0 && !(split && l.landings == 0) {
+                    out.push(deposit(l));
                 }
                 true
             },
         );
+        photon_rays += rays;
         if progress.cancelled() {
             break;
         }
-        phi.fill(Rgb::BLACK);
-        count.fill(0);
-        for &(j, c) in &hits {
-            phi[j as usize] += c;
-            count[j as usize] += 1;
-        }
-        let alpha = settings.alpha as f64;
+        // Cells as wide as the initial radius, which no pixel's exceeds: the grid, and
+        // so the order in which a pixel adds its photons, is then the same whichever
+        // part of the image is rendered (a pixel that got no photons keeps its initial
+        // radius, so the largest radius would hardly be smaller).
+        let global_grid = PhotonGrid::build(deposits, radius);
         state
             .par_iter_mut()
             .zip(samples.par_iter())
-            .zip(phi.par_iter().zip(count.par_iter()))
-            .for_each(|((st, s), (phi, &m))| {
+            .for_each(|(st, s)| {
                 for (c, v) in st.ld.iter_mut().zip(s.ld.to_array()) {
                     *c += v as f64;
                 }
-                if m > 0 {
-                    let m = m as f64;
-                    let n_new = st.n + alpha * m;
-                    let r2_new = st.r2 * n_new / (st.n + m);
-                    let scale = r2_new / st.r2;
-                    let flux = (s.vp.beta * *phi).to_array();
-                    for (t, v) in st.tau.iter_mut().zip(flux) {
-                        *t = (*t + v as f64) * scale;
+                if s.vp.valid {
+                    progress_estimate(&mut st.global, &global_grid, &s.vp, alpha);
+                    if split {
+                        progress_estimate(&mut st.caustic, &caustic_grid, &s.vp, alpha);
                     }
-                    st.n = n_new;
-                    st.r2 = r2_new;
                 }
             });
         stats.photon_seconds += t1.elapsed().as_secs_f64();
@@ -291,7 +400,7 @@ fn render(
         done = it + 1;
         let snapshot = done.is_power_of_two();
         if snapshot || control.watches_passes() {
-            write_estimates(&mut film, &state, done, n_photons);
+            write_estimates(&mut film, &state, done, n_photons, n_caustic);
             control.after_pass(done, &film);
         }
         if snapshot {
@@ -300,9 +409,14 @@ fn render(
         control.boundary(done, &|| snapshot_state(&state, done));
     }
     stats.iterations = done;
-    let mean_r2 = state.iter().map(|s| s.r2).sum::<f64>() / n_pix.max(1) as f64;
-    stats.final_radius = mean_r2.sqrt() as f32;
-    write_estimates(&mut film, &state, done, n_photons);
+    let rms = |r2: fn(&PixelState) -> f64| {
+        (state.iter().map(r2).sum::<f64>() / n_pix.max(1) as f64).sqrt() as f32
+    };
+    stats.final_radius = rms(|s| s.global.r2);
+    if n_caustic > 0 {
+        stats.final_caustic_radius = rms(|s| s.caustic.r2);
+    }
+    write_estimates(&mut film, &state, done, n_photons, n_caustic);
     // Pixels are named in the full image's coordinates.
     if let Some((x, y)) = film.nonfinite.first_pixel {
         film.nonfinite.first_pixel = Some((x + x0, y + y0));
@@ -320,18 +434,79 @@ fn render(
     }
 }
 
+/// The photon as the grid keeps it.
+fn deposit(l: &Landing) -> Deposit {
+    Deposit {
+        p: l.hit.p.to_array(),
+        wi: l.wi.to_array(),
+        power: l.power,
+    }
+}
+
+/// One iteration of a pixel's estimate: the photons of `grid` within its radius,
+/// weighted by the BSDF at the visible point, then the progressive update
+/// (Hachisuka et al. 2008, §4.2): with M photons, N ← N + αM, R² ← R² (N + αM)/(N + M),
+/// τ ← (τ + β Φ) R'²/R².
+fn progress_estimate(est: &mut PhotonEstimate, grid: &PhotonGrid, vp: &VisiblePoint, alpha: f64) {
+    let mut sum = Rgb::BLACK;
+    let mut m = 0u32;
+    grid.for_each_within(vp.p, est.r2 as f32, |d| {
+        let wi = Vec3::from_array(d.wi);
+        // Photons from behind count only where the BSDF transmits diffusely.
+        let front = wi.dot(vp.n) > 0.0;
+        if vp.lambertian {
+            // albedo/π in front, zero behind: weighed once, on the sum.
+            if front {
+                sum += d.power;
+                m += 1;
+            }
+            return;
+        }
+        if !front && !vp.material.transmits_diffusely() {
+            return;
+        }
+        let f = vp.material.eval(vp.wo, vp.frame.to_local(wi));
+        if !f.is_black() {
+            sum += d.power * f;
+            m += 1;
+        }
+    });
+    if m == 0 {
+        return;
+    }
+    let m = m as f64;
+    let n_new = est.n + alpha * m;
+    let r2_new = est.r2 * n_new / (est.n + m);
+    let scale = r2_new / est.r2;
+    let flux = (vp.beta * vp.weigh(sum)).to_array();
+    for (t, v) in est.tau.iter_mut().zip(flux) {
+        *t = (*t + v as f64) * scale;
+    }
+    est.n = n_new;
+    est.r2 = r2_new;
+}
+
 /// Writes each pixel's estimate after `k` iterations into the film (a non-finite one
-/// is counted and left black, as the pass loop does with samples).
-fn write_estimates(film: &mut Film, state: &[PixelState], k: u32, n_photons: u64) {
+/// is counted and left black, as the pass loop does with samples): the direct light's
+/// mean and each photon estimate's τ / (k N_p π R²).
+fn write_estimates(film: &mut Film, state: &[PixelState], k: u32, n_photons: u64, n_caustic: u64) {
     film.nonfinite = NonFinite::default();
     if k == 0 {
         return;
     }
     let kf = k as f64;
     let width = film.width;
+    let density = |est: &PhotonEstimate, c: usize, n: u64| {
+        if n == 0 {
+            0.0
+        } else {
+            est.tau[c] / (kf * n as f64 * PI as f64 * est.r2)
+        }
+    };
     for (i, (px, st)) in film.pixels.iter_mut().zip(state).enumerate() {
-        let area = PI as f64 * st.r2;
-        let v = |c: usize| st.ld[c] / kf + st.tau[c] / (kf * n_photons as f64 * area);
+        let v = |c: usize| {
+            st.ld[c] / kf + density(&st.global, c, n_photons) + density(&st.caustic, c, n_caustic)
+        };
         let value = [v(0), v(1), v(2)];
         if value.iter().all(|c| c.is_finite()) {
             *px = FilmPixel::estimate(value, k);

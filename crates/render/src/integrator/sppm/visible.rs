@@ -15,8 +15,8 @@ use crate::integrator::direct::{ShadingPoint, sample_direct};
 use crate::integrator::specular::{ChainVertex, chain_bounce, glossy_direct};
 use crate::material::Material;
 use crate::world::World;
-use radiant_math::Frame;
 use radiant_math::color::Rgb;
+use radiant_math::{Frame, INV_PI};
 
 /// A camera path's first diffuse point this iteration.
 #[derive(Clone, Copy, Debug)]
@@ -32,7 +32,22 @@ pub struct VisiblePoint {
     pub beta: Rgb,
     /// The material at the point (a mix already resolved).
     pub material: Material,
+    /// Lambertian with the shading normal on the geometric normal's line: the BSDF is
+    /// then albedo/π exactly where a photon arrives on the side of `n`, and zero
+    /// elsewhere, so photons are summed first and weighted once (`weigh`).
+    pub lambertian: bool,
     pub valid: bool,
+}
+
+impl VisiblePoint {
+    /// The gathered sum's contribution: for a Lambertian point the sum of photon
+    /// powers times albedo/π, otherwise the sum already weighted by the BSDF.
+    pub fn weigh(&self, sum: Rgb) -> Rgb {
+        match self.material {
+            Material::Diffuse { albedo } if self.lambertian => sum * albedo * INV_PI,
+            _ => sum,
+        }
+    }
 }
 
 impl Default for VisiblePoint {
@@ -44,6 +59,7 @@ impl Default for VisiblePoint {
             wo: Vec3::Z,
             beta: Rgb::BLACK,
             material: Material::Interface,
+            lambertian: false,
             valid: false,
         }
     }
@@ -129,9 +145,39 @@ pub fn camera_sample(
             wo,
             beta,
             material,
+            lambertian: material.is_diffuse()
+                && (hit.ns == hit.ng || hit.ns == -hit.ng)
+                && wo.z != 0.0,
             valid: true,
         };
         break;
     }
     out
+}
+
+/// True when one of nine camera rays through pixel `(x, y)` (its centre, corners and
+/// edge midpoints, through the lens centre) first meets a surface that photons pass
+/// (a mirror, glass) or an emitter: pixels whose direct light — a light seen in a
+/// mirror, through glass, or at its edge — varies sharply within the pixel and
+/// converges slowly from one camera sample per iteration. The answer depends on no
+/// random number, so taking more direct-light samples where it holds leaves the
+/// estimate unbiased.
+pub fn sees_sharp_direct_light(ctx: &RenderContext, x: u32, y: u32) -> bool {
+    let world = &ctx.world;
+    let centre = glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+    (0..9).any(|k| {
+        let offset = glam::Vec2::new((k % 3) as f32 - 1.0, (k / 3) as f32 - 1.0) * 0.5;
+        let Some(cr) = ctx
+            .camera
+            .generate_ray(centre + offset, glam::Vec2::splat(0.5))
+        else {
+            return false;
+        };
+        world.intersect(&cr.ray, f32::INFINITY).is_some_and(|hit| {
+            hit.light != crate::world::NO_LIGHT
+                || world
+                    .material_at(&hit, -cr.ray.d.normalize())
+                    .passes_photon_paths()
+        })
+    })
 }
