@@ -108,11 +108,12 @@ impl SurfacePoint {
 
     /// The origin for a ray leaving towards `w`: on `w`'s side of the surface, outside the
     /// error box.
-    #[inline]
+    #[inline(always)]
     pub fn spawn_origin(&self, w: Vec3) -> Vec3 {
         offset_ray_origin(self.p, self.p_error, self.n, w)
     }
 
+    #[inline(always)]
     pub fn spawn_ray(&self, w: Vec3) -> Ray {
         Ray::new(self.spawn_origin(w), w)
     }
@@ -120,6 +121,7 @@ impl SurfacePoint {
     /// A ray for the segment from this point to `to`, both ends moved off their surfaces
     /// towards each other, and the `t_max` to trace it with (the far end, less
     /// [`SHADOW_EPSILON`]).
+    #[inline(always)]
     pub fn spawn_ray_to(&self, to: &SurfacePoint) -> (Ray, f32) {
         let o = self.spawn_origin(to.p - self.p);
         let target = to.spawn_origin(o - to.p);
@@ -141,15 +143,38 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     if w.dot(n) < 0.0 {
         offset = -offset;
     }
-    let mut po = p + offset;
-    for i in 0..3 {
-        if offset[i] > 0.0 {
-            po[i] = next_float_up(po[i]);
-        } else if offset[i] < 0.0 {
-            po[i] = next_float_down(po[i]);
-        }
-    }
-    po
+    let po = p + offset;
+    Vec3::new(
+        step_towards_sign(po.x, offset.x),
+        step_towards_sign(po.y, offset.y),
+        step_towards_sign(po.z, offset.z),
+    )
+}
+
+/// [`next_float_up`] of `x` where `dir > 0`, [`next_float_down`] where `dir < 0`, `x`
+/// where `dir` is zero or NaN — without branches. The normal's orientation decides
+/// `dir`, which varies from hit to hit and was mispredicted as a branch; here every
+/// case is a select on the float's bit pattern.
+#[inline(always)]
+fn step_towards_sign(x: f32, dir: f32) -> f32 {
+    let bits = x.to_bits();
+    let dir_bits = dir.to_bits();
+    // Moving away from zero adds one to the magnitude's bits, towards zero subtracts one.
+    let away = (bits ^ dir_bits) >> 31 == 0;
+    let stepped = if away {
+        bits.wrapping_add(1)
+    } else {
+        bits.wrapping_sub(1)
+    };
+    // Both zeros step to the smallest subnormal of `dir`'s sign.
+    let stepped = if x == 0.0 {
+        (dir_bits & 0x8000_0000) | 1
+    } else {
+        stepped
+    };
+    let moved = dir > 0.0 || dir < 0.0;
+    let keep = !moved || x.is_nan() || (away && x.is_infinite());
+    f32::from_bits(if keep { bits } else { stepped })
 }
 
 /// The error bound of `a₀p₀ + a₁p₁ + a₂p₂` for weights in [0, 1] computed in f32
@@ -193,6 +218,45 @@ mod tests {
         }
         assert_eq!(next_float_up(f32::INFINITY), f32::INFINITY);
         assert_eq!(next_float_down(f32::NEG_INFINITY), f32::NEG_INFINITY);
+    }
+
+    #[test]
+    fn branch_free_step_equals_next_float_up_and_down() {
+        let mut rng = Pcg32::new(11, 5);
+        let mut xs = vec![
+            0.0f32,
+            -0.0,
+            1.0,
+            -1.0,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            f32::from_bits(0x8000_0001),
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -f32::NAN,
+        ];
+        xs.extend((0..20_000).map(|_| f32::from_bits(rng.next_u32())));
+        for &x in &xs {
+            for dir in [1.0f32, 3e-30, -2.0, -1e-38, 0.0, -0.0, f32::NAN] {
+                let expect = if dir > 0.0 {
+                    next_float_up(x)
+                } else if dir < 0.0 {
+                    next_float_down(x)
+                } else {
+                    x
+                };
+                let got = step_towards_sign(x, dir);
+                assert!(
+                    got.to_bits() == expect.to_bits() || (got.is_nan() && expect.is_nan()),
+                    "x {x:e} ({:#x}) dir {dir}: {got:e} vs {expect:e}",
+                    x.to_bits()
+                );
+            }
+        }
     }
 
     #[test]

@@ -42,6 +42,26 @@ impl<'a> ShadingPoint<'a> {
         }
     }
 
+    /// `hit` with `material` in the shading `frame` it already has, seen along
+    /// `wo_world` (`wo` in the frame): what [`ShadingPoint::new`] computes, for a caller
+    /// that needed the frame before.
+    pub fn in_frame(
+        hit: &'a SurfaceHit,
+        material: Material,
+        frame: Frame,
+        wo_world: Vec3,
+        wo: Vec3,
+    ) -> ShadingPoint<'a> {
+        ShadingPoint {
+            hit,
+            material,
+            frame,
+            wo,
+            wo_world,
+            mis_with_bsdf: false,
+        }
+    }
+
     /// The same point, for a light sample that MIS combines with a BSDF sample.
     pub fn with_mis(self) -> ShadingPoint<'a> {
         ShadingPoint {
@@ -90,6 +110,7 @@ impl DirectSample {
 
 /// Samples one light for the shading point `at`: `u_choice` picks the light (through
 /// the world's light sampler), `u_light` the point on it.
+#[inline]
 pub fn sample_direct(
     world: &World,
     scene: SceneSphere,

@@ -152,8 +152,10 @@ pub fn radiance(
             }
             break;
         };
-        travelled += hit.t * ray.d.length();
-        let wo_world = -ray.d.normalize();
+        let d_length = ray.d.length();
+        travelled += hit.t * d_length;
+        // `normalize` without a second square root.
+        let wo_world = -ray.d * (1.0 / d_length);
         if hit.light != NO_LIGHT {
             let Light::Area(area) = &world.lights[hit.light as usize] else {
                 unreachable!("primitives only carry area lights")
@@ -183,7 +185,7 @@ pub fn radiance(
         let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
         let u_light = sampler.get_2d();
         if !material.is_specular() {
-            let at = direct::ShadingPoint::new(&hit, material, wo_world).with_mis();
+            let at = direct::ShadingPoint::in_frame(&hit, material, frame, wo_world, wo).with_mis();
             let ds = direct::sample_direct(world, scene, &at, u_choice, u_light);
             rays += ds.shadow_rays;
             if let Some(ds) = ds.light {

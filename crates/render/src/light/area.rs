@@ -273,6 +273,7 @@ impl AreaLight {
     /// A point on the light seen from `ctx`: spheres sample the cone they subtend (far
     /// less variance than area sampling), everything else samples area, converted to
     /// solid angle.
+    #[inline]
     pub fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightLiSample> {
         let p = ctx.p;
         let (p_light, pdf, uv) = match &self.shape {

@@ -21,7 +21,7 @@ use radiant_math::hash::{hash_u64s, mix64, u32_to_unit_f32};
 use radiant_scene::SamplerKind;
 
 pub use halton::{PRIME_COUNT, PRIMES, randomized_radical_inverse};
-pub use sobol::{owen_scramble, scrambled_sobol, sobol_u32};
+pub use sobol::{owen_scramble, owen_scramble_reversed, scrambled_sobol, sobol_u32};
 pub use stratified::{permute, stratified_1d, stratified_2d};
 
 /// The sampler state for one pixel sample.
@@ -31,6 +31,8 @@ pub struct PixelSample {
     /// Hash of (pixel, seed): decorrelates pixels.
     pixel_key: u64,
     index: u32,
+    /// `index` with its bits reversed, as Burley's index shuffle reads it.
+    index_reversed: u32,
     dim: u32,
     /// A stream not tied to a pixel ([`PixelSample::for_stream`]).
     in_stream: bool,
@@ -43,6 +45,7 @@ impl PixelSample {
             kind,
             pixel_key: hash_u64s(&[x as u64, y as u64, seed]),
             index,
+            index_reversed: index.reverse_bits(),
             dim: 0,
             in_stream: false,
         }
@@ -55,6 +58,7 @@ impl PixelSample {
             kind,
             pixel_key: hash_u64s(&[stream, 0x5eed_5eed, seed]),
             index,
+            index_reversed: index.reverse_bits(),
             dim: 0,
             in_stream: true,
         }
@@ -69,6 +73,16 @@ impl PixelSample {
         self.dim
     }
 
+    /// Burley's sample-index shuffle: the index is Owen-scrambled as if it were a binary
+    /// fraction, so each bit flips depending only on the bits above it. The first 2^k
+    /// indices then map to one aligned block of 2^k Sobol points, still a (0,2)-net, but
+    /// a different block and order for each dimension pair.
+    #[inline(always)]
+    fn shuffled_index(&self, key: u64) -> u32 {
+        owen_scramble_reversed(self.index_reversed, (key >> 16) as u32)
+    }
+
+    #[inline(always)]
     fn next_key(&mut self) -> u64 {
         let k = mix64(self.pixel_key ^ (self.dim as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
         self.dim += 1;
@@ -76,15 +90,24 @@ impl PixelSample {
     }
 
     /// One uniform number in [0, 1).
+    #[inline]
     pub fn get_1d(&mut self) -> f32 {
+        // Sobol, the default, inline; the other samplers behind a call.
+        if self.kind == SamplerKind::Sobol {
+            let key = self.next_key();
+            let i = self.shuffled_index(key);
+            return u32_to_unit_f32(scrambled_sobol(0, i, (key >> 32) as u32));
+        }
+        self.get_1d_other()
+    }
+
+    #[inline(never)]
+    fn get_1d_other(&mut self) -> f32 {
         let dim = self.dim;
         let key = self.next_key();
         match self.kind {
             SamplerKind::Independent => independent(key, self.index),
-            SamplerKind::Sobol => {
-                let i = shuffled_index(self.index, key);
-                u32_to_unit_f32(scrambled_sobol(0, i, (key >> 32) as u32))
-            }
+            SamplerKind::Sobol => unreachable!("drawn inline by get_1d"),
             SamplerKind::Halton { randomization } => {
                 let prime = 2 * dim as usize;
                 if prime < PRIME_COUNT {
@@ -118,19 +141,27 @@ impl PixelSample {
     }
 
     /// A pair of uniform numbers in [0, 1)^2, stratified together.
+    #[inline]
     pub fn get_2d(&mut self) -> Vec2 {
+        if self.kind == SamplerKind::Sobol {
+            let key = self.next_key();
+            let i = self.shuffled_index(key);
+            let h = mix64(key);
+            return Vec2::new(
+                u32_to_unit_f32(scrambled_sobol(0, i, h as u32)),
+                u32_to_unit_f32(scrambled_sobol(1, i, (h >> 32) as u32)),
+            );
+        }
+        self.get_2d_other()
+    }
+
+    #[inline(never)]
+    fn get_2d_other(&mut self) -> Vec2 {
         let dim = self.dim;
         let key = self.next_key();
         match self.kind {
             SamplerKind::Independent => independent_2d(key, self.index),
-            SamplerKind::Sobol => {
-                let i = shuffled_index(self.index, key);
-                let h = mix64(key);
-                Vec2::new(
-                    u32_to_unit_f32(scrambled_sobol(0, i, h as u32)),
-                    u32_to_unit_f32(scrambled_sobol(1, i, (h >> 32) as u32)),
-                )
-            }
+            SamplerKind::Sobol => unreachable!("drawn inline by get_2d"),
             SamplerKind::Halton { randomization } => {
                 let prime = 2 * dim as usize;
                 if prime + 1 < PRIME_COUNT {
@@ -165,14 +196,6 @@ fn independent(key: u64, index: u32) -> f32 {
 fn independent_2d(key: u64, index: u32) -> Vec2 {
     let h = mix64(key ^ index as u64);
     Vec2::new(u32_to_unit_f32(h as u32), u32_to_unit_f32((h >> 32) as u32))
-}
-
-/// Burley's sample-index shuffle: the index is Owen-scrambled as if it were a binary
-/// fraction, so each bit flips depending only on the bits above it. The first 2^k
-/// indices then map to one aligned block of 2^k Sobol points, still a (0,2)-net, but a
-/// different block and order for each dimension pair.
-fn shuffled_index(index: u32, key: u64) -> u32 {
-    owen_scramble(index, (key >> 16) as u32)
 }
 
 #[cfg(test)]

@@ -99,7 +99,14 @@ fn laine_karras(mut x: u32, seed: u32) -> u32 {
 /// applied to the bit-reversed value, flips each bit depending only on the bits above
 /// it. The constants are N. Vegdahl's improved hash ("Building a Better LK Hash", 2021).
 pub fn owen_scramble(v: u32, seed: u32) -> u32 {
-    laine_karras(v.reverse_bits(), seed).reverse_bits()
+    owen_scramble_reversed(v.reverse_bits(), seed)
+}
+
+/// [`owen_scramble`] of the value whose bit reversal is `reversed`: for a caller that
+/// scrambles one value under many seeds and reverses it once.
+#[inline(always)]
+pub fn owen_scramble_reversed(reversed: u32, seed: u32) -> u32 {
+    laine_karras(reversed, seed).reverse_bits()
 }
 
 #[cfg(test)]

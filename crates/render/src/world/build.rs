@@ -123,6 +123,7 @@ impl World {
         }
         let light_sampler =
             light_sampler_from_desc(desc, &lights, SceneSphere::around(&bounds), &mut warnings)?;
+        let footprints_used = textured.iter().any(Option::is_some) || !shading_normals.is_empty();
         let world = World {
             geometry: top,
             prototypes,
@@ -130,6 +131,7 @@ impl World {
             textured,
             textures,
             shading_normals,
+            footprints_used,
             cut_outs: desc
                 .shapes
                 .iter()

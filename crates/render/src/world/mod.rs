@@ -59,16 +59,19 @@ pub struct SurfaceHit {
 
 impl SurfaceHit {
     /// The hit as a place rays start from: position, error bound, geometric normal.
+    #[inline(always)]
     pub fn surface_point(&self) -> SurfacePoint {
         SurfacePoint::new(self.p, self.p_error, self.ng)
     }
 
     /// Origin for a ray leaving the surface towards `w`, moved off the surface past the
     /// hit point's error bound.
+    #[inline(always)]
     pub fn spawn_origin(&self, w: Vec3) -> Vec3 {
         self.surface_point().spawn_origin(w)
     }
 
+    #[inline(always)]
     pub fn spawn_ray(&self, w: Vec3) -> Ray {
         self.surface_point().spawn_ray(w)
     }
@@ -133,6 +136,9 @@ pub struct World {
     pub(crate) shading_normals: Vec<Option<ShadingNormal>>,
     /// Some shape has an `alpha` cut-out: rays then test each hit's alpha.
     pub(crate) cut_outs: bool,
+    /// Some material has textures or a bump or normal map: hits then need their
+    /// footprint (when the camera gives one).
+    pub(crate) footprints_used: bool,
     /// The camera's pixel footprint along paths, for texture filtering.
     pub ray_spread: RaySpread,
     pub lights: Vec<Light>,
@@ -163,8 +169,7 @@ impl World {
         travelled: f32,
     ) -> Option<SurfaceHit> {
         let mut hit = self.intersect_shape(ray, t_max)?;
-        let distance = travelled + hit.t * ray.d.length();
-        self.add_footprint(&mut hit, ray.d, distance);
+        self.add_footprint(&mut hit, ray.d, travelled);
         if !self.shading_normals.is_empty() {
             self.perturb_shading_normal(&mut hit, -ray.d.normalize());
         }
@@ -254,6 +259,7 @@ impl World {
 
     /// True when the segment between two points is free: each end is moved off its own
     /// surface (by its error bound, towards the other) and the far end is not counted.
+    #[inline]
     pub fn visible(&self, from: &SurfacePoint, to: &SurfacePoint) -> bool {
         let (ray, t_max) = from.spawn_ray_to(to);
         !self.occluded(&ray, t_max)
@@ -417,12 +423,12 @@ impl World {
         self.textured.iter().any(Option::is_some)
     }
 
-    /// Sets the hit's footprint for a ray of direction `d` that has travelled
-    /// `distance` from the camera (only when textures or bump maps need it).
-    fn add_footprint(&self, hit: &mut SurfaceHit, d: Vec3, distance: f32) {
-        if self.ray_spread != RaySpread::NONE
-            && (self.has_textures() || !self.shading_normals.is_empty())
-        {
+    /// Sets the hit's footprint for a ray of direction `d` that had travelled
+    /// `travelled` from the camera before it started (only when textures or bump maps
+    /// need it, so the distance to the hit is only measured then).
+    fn add_footprint(&self, hit: &mut SurfaceHit, d: Vec3, travelled: f32) {
+        if self.footprints_used && self.ray_spread != RaySpread::NONE {
+            let distance = travelled + hit.t * d.length();
             (hit.dpdx, hit.dpdy) = self.ray_spread.differentials(d, distance, hit.ng);
         }
     }
