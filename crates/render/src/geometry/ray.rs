@@ -172,7 +172,7 @@ fn step_towards_sign(x: f32, dir: f32) -> f32 {
     } else {
         stepped
     };
-    let moved = dir > 0.0 || dir < 0.0;
+    let moved = dir != 0.0 && !dir.is_nan();
     let keep = !moved || x.is_nan() || (away && x.is_infinite());
     f32::from_bits(if keep { bits } else { stepped })
 }
