@@ -32,14 +32,7 @@ impl<'a> ShadingPoint<'a> {
     /// `hit` with `material`, seen along the unit direction `wo_world`.
     pub fn new(hit: &'a SurfaceHit, material: Material, wo_world: Vec3) -> ShadingPoint<'a> {
         let frame = World::shading_frame(hit, &material);
-        ShadingPoint {
-            hit,
-            material,
-            frame,
-            wo: frame.to_local(wo_world),
-            wo_world,
-            mis_with_bsdf: false,
-        }
+        ShadingPoint::in_frame(hit, material, frame, wo_world, frame.to_local(wo_world))
     }
 
     /// `hit` with `material` in the shading `frame` it already has, seen along

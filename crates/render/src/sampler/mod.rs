@@ -21,7 +21,8 @@ use radiant_math::hash::{hash_u64s, mix64, u32_to_unit_f32};
 use radiant_scene::SamplerKind;
 
 pub use halton::{PRIME_COUNT, PRIMES, randomized_radical_inverse};
-pub use sobol::{owen_scramble, owen_scramble_reversed, scrambled_sobol, sobol_u32};
+use sobol::owen_scramble_reversed;
+pub use sobol::{owen_scramble, scrambled_sobol, sobol_u32};
 pub use stratified::{permute, stratified_1d, stratified_2d};
 
 /// The sampler state for one pixel sample.
@@ -82,6 +83,24 @@ impl PixelSample {
         owen_scramble_reversed(self.index_reversed, (key >> 16) as u32)
     }
 
+    /// The Sobol value of dimension key `key` (dimension 0 of the shuffled index).
+    #[inline(always)]
+    fn sobol_1d(&self, key: u64) -> f32 {
+        let i = self.shuffled_index(key);
+        u32_to_unit_f32(scrambled_sobol(0, i, (key >> 32) as u32))
+    }
+
+    /// The Sobol pair of dimension key `key`: dimensions 0 and 1 of the shuffled index.
+    #[inline(always)]
+    fn sobol_2d(&self, key: u64) -> Vec2 {
+        let i = self.shuffled_index(key);
+        let h = mix64(key);
+        Vec2::new(
+            u32_to_unit_f32(scrambled_sobol(0, i, h as u32)),
+            u32_to_unit_f32(scrambled_sobol(1, i, (h >> 32) as u32)),
+        )
+    }
+
     #[inline(always)]
     fn next_key(&mut self) -> u64 {
         let k = mix64(self.pixel_key ^ (self.dim as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
@@ -95,8 +114,7 @@ impl PixelSample {
         // Sobol, the default, inline; the other samplers behind a call.
         if self.kind == SamplerKind::Sobol {
             let key = self.next_key();
-            let i = self.shuffled_index(key);
-            return u32_to_unit_f32(scrambled_sobol(0, i, (key >> 32) as u32));
+            return self.sobol_1d(key);
         }
         self.get_1d_other()
     }
@@ -107,7 +125,7 @@ impl PixelSample {
         let key = self.next_key();
         match self.kind {
             SamplerKind::Independent => independent(key, self.index),
-            SamplerKind::Sobol => unreachable!("drawn inline by get_1d"),
+            SamplerKind::Sobol => self.sobol_1d(key),
             SamplerKind::Halton { randomization } => {
                 let prime = 2 * dim as usize;
                 if prime < PRIME_COUNT {
@@ -145,12 +163,7 @@ impl PixelSample {
     pub fn get_2d(&mut self) -> Vec2 {
         if self.kind == SamplerKind::Sobol {
             let key = self.next_key();
-            let i = self.shuffled_index(key);
-            let h = mix64(key);
-            return Vec2::new(
-                u32_to_unit_f32(scrambled_sobol(0, i, h as u32)),
-                u32_to_unit_f32(scrambled_sobol(1, i, (h >> 32) as u32)),
-            );
+            return self.sobol_2d(key);
         }
         self.get_2d_other()
     }
@@ -161,7 +174,7 @@ impl PixelSample {
         let key = self.next_key();
         match self.kind {
             SamplerKind::Independent => independent_2d(key, self.index),
-            SamplerKind::Sobol => unreachable!("drawn inline by get_2d"),
+            SamplerKind::Sobol => self.sobol_2d(key),
             SamplerKind::Halton { randomization } => {
                 let prime = 2 * dim as usize;
                 if prime + 1 < PRIME_COUNT {

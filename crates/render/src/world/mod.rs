@@ -418,11 +418,6 @@ impl World {
         }
     }
 
-    /// True when some material is textured: only then do integrators need footprints.
-    pub fn has_textures(&self) -> bool {
-        self.textured.iter().any(Option::is_some)
-    }
-
     /// Sets the hit's footprint for a ray of direction `d` that had travelled
     /// `travelled` from the camera before it started (only when textures or bump maps
     /// need it, so the distance to the hit is only measured then).
