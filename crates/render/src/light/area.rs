@@ -178,6 +178,7 @@ impl AreaLight {
     }
 
     /// A point on the light sampled uniformly by render-space area, with its (u, v).
+    #[inline(always)]
     fn sample_area(&self, u: Vec2) -> Option<EmitterSample> {
         let with_uv = self.image.is_some();
         let plain = |area: AreaSample| EmitterSample {

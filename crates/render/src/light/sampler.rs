@@ -89,6 +89,7 @@ impl LightSampler {
     }
 
     /// Picks a light for the receiver `ctx`; `None` when there are none.
+    #[inline]
     pub fn sample(&self, ctx: &LightSampleContext, u: f32) -> Option<SampledLight> {
         match self {
             LightSampler::Power { distribution } => sample_distribution(distribution, u),

@@ -162,6 +162,7 @@ impl World {
     /// [`intersect`](Self::intersect) for a ray of a camera path that has travelled
     /// `travelled` before this segment: the hit also gets its pixel footprint, which
     /// texture filters and the bump map's finite-difference step use.
+    #[inline(always)]
     pub fn intersect_with_footprint(
         &self,
         ray: &Ray,
@@ -177,6 +178,7 @@ impl World {
     }
 
     /// The closest hit as the shape reports it (alpha cut-outs skipped).
+    #[inline(always)]
     fn intersect_shape(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
         crate::stats::add(crate::stats::Counter::ClosestHitTests, 1);
         let hit = if self.cut_outs {
@@ -410,6 +412,7 @@ impl World {
     /// first axis along ∂p/∂u for anisotropic BSDFs (pbrt's orientation of
     /// `uroughness`). Isotropic BSDFs do not depend on the tangent, and keep the
     /// branch-free frame of the normal alone.
+    #[inline(always)]
     pub fn shading_frame(hit: &SurfaceHit, material: &Material) -> Frame {
         if material.is_anisotropic() {
             Frame::from_normal_tangent(hit.ns, hit.dpdu)

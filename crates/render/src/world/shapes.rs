@@ -319,12 +319,20 @@ impl ShapeSet {
         }
     }
 
+    #[inline(always)]
     pub(crate) fn intersect(
         &self,
         ray: &Ray,
         t_max: f32,
         prototypes: &[ShapeSet],
     ) -> Option<SurfaceHit> {
+        if self.prims.is_empty() {
+            // Triangles only: the mesh hit expands straight into the surface hit, with
+            // no raw hit stored in between (its fields, written one by one and read
+            // back as wider words, stalled store-to-load forwarding).
+            let h = self.triangle_bvh.intersect(ray, t_max)?;
+            return Some(self.triangle_hit(h.t, h.prim, h.b));
+        }
         let (t, raw, instance) = self.intersect_raw(ray, t_max, prototypes)?;
         match instance {
             None => Some(self.surface_hit(t, raw)),
@@ -374,6 +382,7 @@ impl ShapeSet {
                 })
     }
 
+    #[inline(always)]
     fn surface_hit(&self, t: f32, raw: RawHit) -> SurfaceHit {
         match raw {
             RawHit::Triangle { index, b } => self.triangle_hit(t, index, b),
