@@ -243,7 +243,6 @@ impl Light {
 
     /// A direction towards the light from `ctx`, or `None` when the sample carries
     /// nothing (back side, outside a spot's cone).
-    #[inline(always)]
     pub fn sample_li(
         &self,
         ctx: &LightSampleContext,

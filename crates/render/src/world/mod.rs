@@ -412,7 +412,6 @@ impl World {
     /// first axis along ∂p/∂u for anisotropic BSDFs (pbrt's orientation of
     /// `uroughness`). Isotropic BSDFs do not depend on the tangent, and keep the
     /// branch-free frame of the normal alone.
-    #[inline(always)]
     pub fn shading_frame(hit: &SurfaceHit, material: &Material) -> Frame {
         if material.is_anisotropic() {
             Frame::from_normal_tangent(hit.ns, hit.dpdu)

@@ -382,7 +382,6 @@ impl ShapeSet {
                 })
     }
 
-    #[inline(always)]
     fn surface_hit(&self, t: f32, raw: RawHit) -> SurfaceHit {
         match raw {
             RawHit::Triangle { index, b } => self.triangle_hit(t, index, b),
