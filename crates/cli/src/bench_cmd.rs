@@ -9,8 +9,8 @@ use radiant::render::bench::{environment_benchmark, render_benchmark, world_ray_
 use radiant::render::context::{Overrides, Progress};
 use radiant::render::integrator::photon::bench::photon_benchmark;
 use radiant::render::texture::bench::texture_lookup_benchmark;
-use radiant::scene::SceneDesc;
 use radiant::scene::builtin::cornell_box;
+use radiant::scene::{ParamValue, SceneDesc};
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
@@ -261,7 +261,7 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
     for seed in 1..=seeds {
         let start = cpu_seconds();
         let session = radiant::Session::new(
-            &cornell_box(),
+            &matched_roulette(cornell_box()),
             &Overrides {
                 spp: Some(256),
                 seed: Some(seed),
@@ -273,7 +273,7 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
         per_256.push(cpu_seconds() - start);
     }
     println!(
-        "cornell-box, path, 256 spp at the default Russian roulette: median {:.1} CPU-s  [{}]",
+        "cornell-box, path, 256 spp at Mitsuba 3's Russian roulette (rrdepth 4, rrthreshold 1): median {:.1} CPU-s  [{}]",
         median(per_256.clone()),
         per_256
             .iter()
@@ -282,6 +282,18 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
             .join(", ")
     );
     Ok(())
+}
+
+/// `desc` with Mitsuba 3's Russian roulette (its `rr_depth` 5 counts the camera vertex;
+/// survival by the throughput itself), so that the cost per sample compares at equal
+/// path lengths.
+fn matched_roulette(mut desc: SceneDesc) -> SceneDesc {
+    desc.integrator.params = desc
+        .integrator
+        .params
+        .with("rrdepth", ParamValue::Int(vec![4]))
+        .with("rrthreshold", ParamValue::Float(vec![1.0]));
+    desc
 }
 
 /// `data/scenes/bitterli/teapot/scene-v4.pbrt` under the shared data folder:

@@ -4,8 +4,8 @@
 use radiant::Session;
 use radiant::image::Image;
 use radiant::render::{Overrides, Progress};
-use radiant::scene::SceneDesc;
 use radiant::scene::builtin::{cornell_box, furnace};
+use radiant::scene::{ParamValue, SceneDesc};
 use radiant_testkit::fixtures::{LIT_SPHERE_RADIANCE, lit_sphere};
 
 fn render(desc: &SceneDesc, spp: u32, threads: usize) -> Image {
@@ -38,10 +38,11 @@ fn stats(img: &Image, channel: usize) -> (f64, f64) {
 /// Every pixel of the furnace converges to Le / (1 - albedo) = 2. All pixels share one
 /// distribution, so the spread between pixels measures the per-pixel noise: the image
 /// mean must lie within 4 standard errors of 2. Pixels are not normally distributed: a
-/// path that survives Russian roulette (from the fifth vertex on) goes on with a weight
-/// near 1, so a pixel's 16 paths have a long right tail (measured: 1.4 % of 4096 pixels
-/// beyond 3 standard deviations, against 0.27 % for a normal distribution, the largest
-/// 8 standard deviations out). So at most 3 % may lie beyond 3 standard deviations, and
+/// path that survives Russian roulette goes on with its weight raised to the roulette
+/// threshold, so a pixel's 16 paths have a long right tail (measured with roulette from
+/// the fifth vertex at threshold 1: 1.4 % of 4096 pixels beyond 3 standard deviations,
+/// against 0.27 % for a normal distribution, the largest 8 standard deviations out). So
+/// at most 3 % may lie beyond 3 standard deviations, and
 /// every pixel holds what every sample must — at least the emission seen first, 1 —
 /// and lies within 16 standard deviations.
 #[test]
@@ -65,6 +66,31 @@ fn white_furnace_is_two_everywhere() {
             "channel {c}: {beyond_3} of {} pixels beyond 3 sd",
             img.pixels.len()
         );
+    }
+}
+
+/// Russian roulette's threshold changes the noise, not the mean: from pbrt-v4's rule
+/// (θ = 1) down to θ = 0.05, with roulette from the first bounce on, every channel of
+/// the furnace stays within 4 standard errors of 2.
+#[test]
+fn roulette_thresholds_keep_the_furnace_at_two() {
+    for theta in [1.0f32, 0.35, 0.05] {
+        let mut desc = furnace();
+        desc.integrator.params = desc
+            .integrator
+            .params
+            .clone()
+            .with("rrdepth", ParamValue::Int(vec![0]))
+            .with("rrthreshold", ParamValue::Float(vec![theta]));
+        let img = render(&desc, 16, 2);
+        for c in 0..3 {
+            let (mean, sd) = stats(&img, c);
+            let se = sd / (img.pixels.len() as f64).sqrt();
+            assert!(
+                (mean - 2.0).abs() < 4.0 * se + 1e-6,
+                "threshold {theta}, channel {c}: mean {mean}, se {se}"
+            );
+        }
     }
 }
 

@@ -423,6 +423,7 @@ fn lossless_thin_materials_vanish_in_a_white_furnace() {
     let settings = PathSettings {
         max_depth: 1000,
         rr_depth: 5,
+        ..Default::default()
     };
     for (k, x) in [-2.5f32, 0.0, 2.5].into_iter().enumerate() {
         let n = 20_000u32;

@@ -322,6 +322,7 @@ fn radiance_discrepancy_is_shared_by_the_path_tracer() {
     let settings = PathSettings {
         max_depth: 100,
         rr_depth: 5,
+        ..Default::default()
     };
     let converged = both_grids(&converged_radiance());
     let wanted = [

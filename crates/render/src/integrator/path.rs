@@ -22,39 +22,64 @@ pub struct PathSettings {
     /// bounce still counts.
     pub max_depth: u32,
     /// Bounces before Russian roulette may end a path: [`DEFAULT_RR_DEPTH`] unless the
-    /// scene says `"integer rrdepth"` (pbrt-v4 starts after 1).
+    /// scene says `"integer rrdepth"` (pbrt-v4's default is 1 too).
     pub rr_depth: u32,
+    /// The throughput below which roulette plays, [`DEFAULT_RR_THRESHOLD`] unless the
+    /// scene says `"float rrthreshold"` (a radiant parameter; 1 is pbrt-v4's and
+    /// Mitsuba 3's rule).
+    pub rr_threshold: f32,
 }
 
 /// Russian roulette starts after this many bounces by default.
 ///
-/// Chosen by efficiency, 1 / (relMSE × CPU time) against the references, at equal
-/// samples per pixel on one thread (two seeds, medians); relMSE × CPU-s for `rrdepth`
-/// 1 / 2 / 3 / 4 / 5 / 6 / 8 (lower is better):
+/// With [`DEFAULT_RR_THRESHOLD`] the start matters less than with θ = 1, since paths
+/// whose throughput is above the threshold are never ended whatever their depth; what
+/// it still decides is how soon the paths of dark surfaces are thinned out. Measured
+/// (docs/speed.md, θ = 0.35, 128 spp, relMSE × CPU-s against the pbrt-v4 references):
+/// starting after 1 bounce saves the most time in dark scenes (dining-room: 0.55× the
+/// CPU time of starting after 4, at equal error) but its early survivors carry weights
+/// up to θ / β and add fireflies to glossy ones (material-testball: relMSE +24 %);
+/// after 2 keeps the error of starting after 4 there at 0.88× its time, and after 3
+/// gives up most of the dark-scene gain. pbrt-v4 starts after 1, Mitsuba 3 after 4 (its
+/// `rr_depth` 5 counts the camera vertex).
+pub const DEFAULT_RR_DEPTH: u32 = 2;
+
+/// The throughput below which Russian roulette plays, by default: a path survives with
+/// probability min(1, max channel of β η² / θ), and β is divided by it, so that each
+/// survivor carries throughput θ (η² undoes the radiance scaling at refractions, so
+/// that roulette sees the transported importance; Arvo & Kirk, "Particle Transport and
+/// Image Synthesis", 1990). pbrt-v4 and Mitsuba 3 play it below θ = 1, the camera's
+/// weight.
 ///
-/// - cornell-box, 128 spp: 0.0214 / 0.0186 / 0.0176 / **0.0168** / 0.0173 / 0.0180 / 0.0187;
-/// - cornell-caustics, 64 spp, `rrdepth` 1 / 2 / 3 / 4 / 6: 0.256 / 0.268 / 0.292 / 0.289 /
-///   0.309 — its error is the caustics' rare bright paths, heavy-tailed, so two seeds
-///   hardly separate the settings; the caustics are SPPM's to render.
-///
-/// Starting at 1 ends many paths whose next vertex still gathers much light (the white
-/// walls reflect 70–90 %), for little time saved: each path's first bounces are its
-/// cheapest in error per ray. Past 4 the deep bounces cost more time than the variance
-/// they remove. 4 is also where Mitsuba 3's `rr_depth` 5 starts (it counts the camera
-/// vertex), so the two renderers compare at matched settings.
-///
-/// The survival rule stays the throughput's: a path survives with probability
-/// min(1, max channel of β η²) (η² undoing the radiance scaling at refractions, so that
-/// roulette sees the transported importance), and β is divided by it — each surviving
-/// path then carries about the weight it had at the start of the roulette (Arvo & Kirk,
-/// "Particle Transport and Image Synthesis", 1990).
-pub const DEFAULT_RR_DEPTH: u32 = 4;
+/// Chosen by efficiency, 1 / (relMSE × cost), against the references (docs/speed.md).
+/// cornell-box, relMSE at 128 spp (1e-3) × rays at 16 spp (millions), for (`rrdepth`,
+/// θ): (4, 1) 8.38, (4, 0.5) 7.24, (4, 0.35) 7.07, (2, 0.5) 6.89, **(2, 0.35) 6.69**,
+/// (2, 0.25) 6.75, (1, 0.35) 6.62. The optimum is flat between 0.25 and 0.5. At θ = 1 a
+/// path whose throughput has fallen to 0.3 is ended seven times in ten and the
+/// survivors are weighted by 3.3: in a room whose walls reflect 70–90 % they still
+/// gather much light, and those weights are the noise. A lower threshold lets paths
+/// decay to θ first; past it each survival renormalises the path to θ and later bounces
+/// survive about as often as the albedo, as with θ = 1, so the extra cost is a few rays
+/// per path. Against the old default (4, 1) on the real scenes (128 spp, two seeds):
+/// relMSE × CPU-s 0.80× on cornell-caustics (path), 0.88× material-testball, 0.96×
+/// teapot, 0.91× coffee, 0.73× dining-room, 0.92× staircase2.
+pub const DEFAULT_RR_THRESHOLD: f32 = 0.35;
 
 impl PathSettings {
     pub fn from_desc(desc: &IntegratorDesc) -> Result<PathSettings, SceneError> {
+        let rr_threshold = desc
+            .params
+            .finite_float("rrthreshold", DEFAULT_RR_THRESHOLD)?;
+        if rr_threshold <= 0.0 {
+            return Err(SceneError::at(
+                &desc.loc,
+                format!("\"rrthreshold\" must be positive, got {rr_threshold}"),
+            ));
+        }
         Ok(PathSettings {
             max_depth: desc.params.count("maxdepth", 5)?,
             rr_depth: desc.params.count("rrdepth", DEFAULT_RR_DEPTH)?,
+            rr_threshold,
         })
     }
 }
@@ -64,6 +89,7 @@ impl Default for PathSettings {
         PathSettings {
             max_depth: 5,
             rr_depth: DEFAULT_RR_DEPTH,
+            rr_threshold: DEFAULT_RR_THRESHOLD,
         }
     }
 }
@@ -225,7 +251,7 @@ pub fn radiance(
 
         let roulette = depth > settings.rr_depth;
         let u_rr = sampler.get_1d_if(roulette);
-        let rr_beta = beta.max_component() * eta_scale;
+        let rr_beta = beta.max_component() * eta_scale / settings.rr_threshold;
         if roulette && rr_beta < 1.0 {
             let q = (1.0 - rr_beta).max(0.0);
             if u_rr < q {
@@ -238,4 +264,37 @@ pub fn radiance(
         }
     }
     (l, rays)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn settings(integrator: &str) -> Result<PathSettings, SceneError> {
+        let text = format!("{integrator}\nWorldBegin\n");
+        let desc = radiant_scene::parse_str(&text, "rr.pbrt", Path::new(".")).expect("parses");
+        PathSettings::from_desc(&desc.integrator)
+    }
+
+    #[test]
+    fn roulette_parameters_default_and_parse() {
+        let d = settings(r#"Integrator "path""#).unwrap();
+        assert_eq!(
+            (d.rr_depth, d.rr_threshold),
+            (DEFAULT_RR_DEPTH, DEFAULT_RR_THRESHOLD)
+        );
+        let s = settings(r#"Integrator "path" "integer rrdepth" 4 "float rrthreshold" 1"#).unwrap();
+        assert_eq!((s.rr_depth, s.rr_threshold), (4, 1.0));
+    }
+
+    #[test]
+    fn a_threshold_that_is_not_positive_is_an_error_at_its_integrator() {
+        for bad in ["0", "-0.5"] {
+            let e = settings(&format!(r#"Integrator "path" "float rrthreshold" {bad}"#))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("rr.pbrt:1:") && e.contains("rrthreshold"), "{e}");
+        }
+    }
 }
