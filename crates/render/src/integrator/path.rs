@@ -37,10 +37,10 @@ pub struct PathSettings {
 /// it still decides is how soon the paths of dark surfaces are thinned out. Measured
 /// (docs/speed.md, θ = 0.35, 128 spp, relMSE × CPU-s against the pbrt-v4 references):
 /// starting after 1 bounce saves the most time in dark scenes (dining-room: 0.55× the
-/// CPU time of starting after 4, at equal error) but its early survivors carry weights
-/// up to θ / β and add fireflies to glossy ones (material-testball: relMSE +24 %);
-/// after 2 keeps the error of starting after 4 there at 0.88× its time, and after 3
-/// gives up most of the dark-scene gain. pbrt-v4 starts after 1, Mitsuba 3 after 4 (its
+/// CPU time of the earlier default, after 4 at θ = 1, for about its error) but its
+/// early survivors carry weights up to θ / β and add fireflies to glossy ones
+/// (material-testball: relMSE +24 %); after 2 keeps the earlier default's error there
+/// at 0.88× its time, and after 3 gives up most of the dark-scene gain. pbrt-v4 starts after 1, Mitsuba 3 after 4 (its
 /// `rr_depth` 5 counts the camera vertex).
 pub const DEFAULT_RR_DEPTH: u32 = 2;
 
