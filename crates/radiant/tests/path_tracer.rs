@@ -35,6 +35,18 @@ fn stats(img: &Image, channel: usize) -> (f64, f64) {
     (mean, sd)
 }
 
+/// The image mean of `channel` lies within 4 standard errors (from the spread between
+/// pixels) of `expected`; returns the standard deviation between pixels.
+fn assert_mean_near(img: &Image, channel: usize, expected: f64, what: &str) -> f64 {
+    let (mean, sd) = stats(img, channel);
+    let se = sd / (img.pixels.len() as f64).sqrt();
+    assert!(
+        (mean - expected).abs() < 4.0 * se + 1e-6,
+        "{what}, channel {channel}: mean {mean}, se {se}"
+    );
+    sd
+}
+
 /// Every pixel of the furnace converges to Le / (1 - albedo) = 2. All pixels share one
 /// distribution, so the spread between pixels measures the per-pixel noise: the image
 /// mean must lie within 4 standard errors of 2. Pixels are not normally distributed: a
@@ -42,19 +54,14 @@ fn stats(img: &Image, channel: usize) -> (f64, f64) {
 /// threshold, so a pixel's 16 paths have a long right tail (measured with roulette from
 /// the fifth vertex at threshold 1: 1.4 % of 4096 pixels beyond 3 standard deviations,
 /// against 0.27 % for a normal distribution, the largest 8 standard deviations out). So
-/// at most 3 % may lie beyond 3 standard deviations, and
-/// every pixel holds what every sample must — at least the emission seen first, 1 —
-/// and lies within 16 standard deviations.
+/// at most 3 % may lie beyond 3 standard deviations, and every pixel holds what every
+/// sample must — at least the emission seen first, 1 — and lies within 16 standard
+/// deviations.
 #[test]
 fn white_furnace_is_two_everywhere() {
     let img = render(&furnace(), 16, 2);
     for c in 0..3 {
-        let (mean, sd) = stats(&img, c);
-        let se = sd / (img.pixels.len() as f64).sqrt();
-        assert!(
-            (mean - 2.0).abs() < 4.0 * se + 1e-6,
-            "channel {c}: mean {mean}, se {se}"
-        );
+        let sd = assert_mean_near(&img, c, 2.0, "furnace");
         let mut beyond_3 = 0usize;
         for p in &img.pixels {
             let d = (p[c] as f64 - 2.0).abs();
@@ -84,12 +91,7 @@ fn roulette_thresholds_keep_the_furnace_at_two() {
             .with("rrthreshold", ParamValue::Float(vec![theta]));
         let img = render(&desc, 16, 2);
         for c in 0..3 {
-            let (mean, sd) = stats(&img, c);
-            let se = sd / (img.pixels.len() as f64).sqrt();
-            assert!(
-                (mean - 2.0).abs() < 4.0 * se + 1e-6,
-                "threshold {theta}, channel {c}: mean {mean}, se {se}"
-            );
+            assert_mean_near(&img, c, 2.0, &format!("threshold {theta}"));
         }
     }
 }
@@ -99,12 +101,7 @@ fn roulette_thresholds_keep_the_furnace_at_two() {
 #[test]
 fn analytic_sphere_with_point_light_gives_radiance_one() {
     let img = render(&lit_sphere(), 16, 2);
-    let (mean, sd) = stats(&img, 1);
-    let se = sd / (img.pixels.len() as f64).sqrt();
-    assert!(
-        (mean - LIT_SPHERE_RADIANCE as f64).abs() < 4.0 * se + 1e-6,
-        "mean {mean}, se {se}"
-    );
+    assert_mean_near(&img, 1, LIT_SPHERE_RADIANCE as f64, "lit sphere");
 }
 
 /// The same scene, seed and sample count give the same image at any thread count.
