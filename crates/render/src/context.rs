@@ -249,7 +249,7 @@ impl RenderContext {
     pub fn camera_sample(&self, sampler: &mut PixelSample, x: u32, y: u32) -> CameraSample {
         let fs = self.filter.sample(sampler.get_2d());
         let raster = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + fs.offset;
-        let u_lens = sampler.get_2d();
+        let u_lens = sampler.get_2d_if(self.camera.uses_lens_sample());
         let ray = self.camera.generate_ray(raster, u_lens);
         if ray.is_some() {
             crate::stats::add(crate::stats::Counter::CameraRays, 1);

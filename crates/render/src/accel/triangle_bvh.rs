@@ -5,7 +5,7 @@
 #[cfg(target_arch = "x86_64")]
 use super::avx::{Avx, NodeRay8, WatertightRay8};
 use super::build::{BuildSettings, build_binary, collapse};
-use super::node::{MAX_LEAF_ITEMS, NodeRay, decode_leaf, encode_leaf};
+use super::node::{MAX_LEAF_ITEMS, NodeRay, WideNode, decode_leaf, encode_leaf};
 use super::traverse::{
     self, AnyLeaf, ClosestLeaf, LARGE_STACK, NodeTree, SMALL_STACK, StackSize, TINY_STACK,
 };
@@ -33,6 +33,9 @@ pub struct TriangleBvh {
     packet_prims: Vec<[u32; 4]>,
     order: Vec<u32>,
     bounds: Aabb,
+    /// Whether traversal touches the children it enters ahead of visiting them: only for
+    /// trees too large to stay in cache (`traverse::small_enough_to_stay_cached`).
+    prefetch: bool,
     /// Set when the processor has AVX: queries then test eight boxes and eight triangles
     /// at once (the same hits, bit for bit).
     #[cfg(target_arch = "x86_64")]
@@ -96,12 +99,15 @@ impl TriangleBvh {
         let bounds = order
             .iter()
             .fold(Aabb::EMPTY, |b, &i| b.union(&bounds[i as usize]));
+        let bytes = nodes.len() * std::mem::size_of::<WideNode>()
+            + packets.len() * std::mem::size_of::<Triangle4>();
         TriangleBvh {
             nodes,
             packets,
             packet_prims,
             order,
             bounds,
+            prefetch: !traverse::small_enough_to_stay_cached(bytes),
             #[cfg(target_arch = "x86_64")]
             avx: Avx::detect(),
         }
@@ -428,6 +434,11 @@ impl ClosestLeaf for ClosestBlocks<'_> {
     fn touch(&self, leaf: u32) {
         self.bvh.touch_leaf(leaf);
     }
+
+    #[inline(always)]
+    fn prefetches(&self) -> bool {
+        self.bvh.prefetch
+    }
 }
 
 struct AnyBlock<'a> {
@@ -444,6 +455,11 @@ impl AnyLeaf for AnyBlock<'_> {
     #[inline(always)]
     fn touch(&self, leaf: u32) {
         self.bvh.touch_leaf(leaf);
+    }
+
+    #[inline(always)]
+    fn prefetches(&self) -> bool {
+        self.bvh.prefetch
     }
 }
 
@@ -465,6 +481,11 @@ impl ClosestLeaf for ClosestBlocks8<'_> {
     fn touch(&self, leaf: u32) {
         self.bvh.touch_leaf(leaf);
     }
+
+    #[inline(always)]
+    fn prefetches(&self) -> bool {
+        self.bvh.prefetch
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -483,5 +504,10 @@ impl AnyLeaf for AnyBlock8<'_> {
     #[inline(always)]
     fn touch(&self, leaf: u32) {
         self.bvh.touch_leaf(leaf);
+    }
+
+    #[inline(always)]
+    fn prefetches(&self) -> bool {
+        self.bvh.prefetch
     }
 }

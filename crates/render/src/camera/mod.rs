@@ -33,6 +33,15 @@ pub enum Camera {
 }
 
 impl Camera {
+    /// True when [`Camera::generate_ray`] reads its aperture sample `u_lens` (a pinhole
+    /// does not).
+    pub fn uses_lens_sample(&self) -> bool {
+        match self {
+            Camera::Projective(c) => c.lens_radius > 0.0,
+            Camera::Realistic { .. } => true,
+        }
+    }
+
     /// A ray through continuous raster position `raster` ((0,0) is the top-left corner
     /// of the image, +x right, +y down), using `u_lens` for the aperture.
     pub fn generate_ray(&self, raster: Vec2, u_lens: Vec2) -> Option<CameraRay> {

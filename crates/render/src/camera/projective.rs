@@ -105,6 +105,25 @@ mod tests {
         assert!((right.x / right.z - 2.0).abs() < 1e-5);
     }
 
+    /// The sampler skips the aperture draw of cameras that say they do not read it.
+    #[test]
+    fn only_a_lens_reads_the_aperture_sample() {
+        let mut c = camera(40.0, (64, 64));
+        let rays = |c: &ProjectiveCamera| {
+            [Vec2::ZERO, Vec2::new(0.1, 0.9), Vec2::new(0.8, 0.3)].map(|u| {
+                let r = c.generate_ray(Vec2::new(10.0, 50.0), u).ray;
+                (r.o, r.d)
+            })
+        };
+        let pinhole = rays(&c);
+        assert!(!crate::camera::Camera::Projective(c.clone()).uses_lens_sample());
+        assert!(pinhole.iter().all(|r| *r == pinhole[0]));
+        c.lens_radius = 0.5;
+        let lens = rays(&c);
+        assert!(crate::camera::Camera::Projective(c).uses_lens_sample());
+        assert!(lens[1] != lens[2]);
+    }
+
     #[test]
     fn thin_lens_rays_converge_on_the_focal_plane() {
         let mut c = camera(40.0, (64, 64));

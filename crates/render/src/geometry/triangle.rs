@@ -31,6 +31,9 @@ pub struct WatertightRay {
 }
 
 impl WatertightRay {
+    /// Always inlined: as a call its result went through memory and was read back
+    /// field by field at the start of every traversal.
+    #[inline(always)]
     pub fn new(ray: &Ray) -> WatertightRay {
         let a = ray.d.abs();
         let kz = if a.x > a.y {
@@ -43,7 +46,8 @@ impl WatertightRay {
         let mut kx = (kz + 1) % 3;
         let mut ky = (kx + 1) % 3;
         // Keep the winding (and hence the sign of the determinant) consistent.
-        if ray.d[kz] < 0.0 {
+        let d = ray.d.to_array();
+        if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
         WatertightRay {
@@ -51,9 +55,9 @@ impl WatertightRay {
             kx,
             ky,
             kz,
-            sx: ray.d[kx] / ray.d[kz],
-            sy: ray.d[ky] / ray.d[kz],
-            sz: 1.0 / ray.d[kz],
+            sx: d[kx] / d[kz],
+            sy: d[ky] / d[kz],
+            sz: 1.0 / d[kz],
         }
     }
 }

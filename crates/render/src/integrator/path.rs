@@ -208,9 +208,10 @@ pub fn radiance(
         let wo = frame.to_local(wo_world);
 
         // Drawn for every vertex so that the dimension layout does not depend on the material.
-        let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
-        let u_light = sampler.get_2d();
-        if !material.is_specular() {
+        let lit = !material.is_specular();
+        let u_choice = sampler.get_1d_if(lit && world.light_sampler.uses_choice_sample());
+        let u_light = sampler.get_2d_if(lit);
+        if lit {
             let at = direct::ShadingPoint::in_frame(&hit, material, frame, wo_world, wo).with_mis();
             let ds = direct::sample_direct(world, scene, &at, u_choice, u_light);
             rays += ds.shadow_rays;
@@ -224,7 +225,7 @@ pub fn radiance(
             }
         }
 
-        let u_lobe = sampler.get_1d();
+        let u_lobe = sampler.get_1d_if(material.uses_lobe_sample());
         let u_dir = sampler.get_2d();
         let Some(bs) = material.sample(wo, u_lobe, u_dir, TransportMode::Radiance) else {
             break;
@@ -249,10 +250,10 @@ pub fn radiance(
         prev_ctx = hit.light_sample_context().with_mis();
         ray = hit.spawn_ray(wi);
 
-        let roulette = depth > settings.rr_depth;
-        let u_rr = sampler.get_1d_if(roulette);
         let rr_beta = beta.max_component() * eta_scale / settings.rr_threshold;
-        if roulette && rr_beta < 1.0 {
+        let roulette = depth > settings.rr_depth && rr_beta < 1.0;
+        let u_rr = sampler.get_1d_if(roulette);
+        if roulette {
             let q = (1.0 - rr_beta).max(0.0);
             if u_rr < q {
                 break;

@@ -32,7 +32,7 @@ pub fn specular_bounce(
     sampler: &mut PixelSample,
     beta: &mut Rgb,
 ) -> Option<Vec3> {
-    let u_lobe = sampler.get_1d();
+    let u_lobe = sampler.get_1d_if(material.uses_lobe_sample());
     let u_dir = sampler.get_2d();
     let bs = material.sample(wo, u_lobe, u_dir, TransportMode::Radiance)?;
     *beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
@@ -113,7 +113,7 @@ pub fn chain_bounce(
     beta: &mut Rgb,
 ) -> Option<(Vec3, ChainVertex)> {
     let wo = frame.to_local(wo_world);
-    let u_lobe = sampler.get_1d();
+    let u_lobe = sampler.get_1d_if(material.uses_lobe_sample());
     let u_dir = sampler.get_2d();
     let bs = material.sample(wo, u_lobe, u_dir, TransportMode::Radiance)?;
     let wi = frame.to_world(bs.wi);

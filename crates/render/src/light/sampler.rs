@@ -128,10 +128,15 @@ impl LightSampler {
 }
 
 fn sample_distribution(distribution: &Distribution1D, u: f32) -> Option<SampledLight> {
-    if distribution.is_empty() {
-        return None;
-    }
-    let (index, pmf, _) = distribution.sample(u);
+    let (index, pmf) = match distribution.len() {
+        0 => return None,
+        // One light (a single-emitter scene): no search, what the search would find.
+        1 => (0, distribution.pmf(0)),
+        _ => {
+            let (index, pmf, _) = distribution.sample(u);
+            (index, pmf)
+        }
+    };
     (pmf > 0.0).then_some(SampledLight { index, pmf })
 }
 

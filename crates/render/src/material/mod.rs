@@ -176,6 +176,25 @@ impl Material {
         }
     }
 
+    /// True when [`Material::sample`] reads its lobe-choice number `u1`. Callers that
+    /// draw it from a sampler can skip computing it otherwise (the dimension is still
+    /// consumed, so the numbers that follow do not depend on the material).
+    pub fn uses_lobe_sample(&self) -> bool {
+        match self {
+            Material::Dielectric { .. }
+            | Material::RoughDielectric { .. }
+            | Material::ThinDielectric { .. }
+            | Material::DiffuseTransmission { .. }
+            | Material::CoatedDiffuse { .. }
+            | Material::CoatedConductor { .. } => true,
+            Material::Diffuse { .. }
+            | Material::Mirror { .. }
+            | Material::Conductor { .. }
+            | Material::RoughConductor { .. }
+            | Material::Interface => false,
+        }
+    }
+
     /// True when the BSDF is a Dirac distribution (no evaluation, only sampling).
     pub fn is_specular(&self) -> bool {
         if let Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } = self {

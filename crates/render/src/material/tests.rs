@@ -119,3 +119,57 @@ fn refraction_radiance_scaling_cancels_on_a_round_trip() {
     let w_out = s_out.f.r * s_out.wi.z.abs() / s_out.pdf;
     assert!((w_in * w_out - 1.0).abs() < 1e-5, "{w_in} {w_out}");
 }
+
+/// Callers skip drawing the lobe-choice number of materials that say they do not read
+/// it, and pass 0 instead: for those, no value of it may change a sample. The materials
+/// that do read it must show it (else the flag costs draws for nothing).
+#[test]
+fn the_lobe_sample_flag_says_which_materials_read_it() {
+    let grey = Rgb::splat(0.5);
+    let descs = [
+        MaterialDesc::Diffuse { reflectance: grey },
+        MaterialDesc::Conductor(ConductorDesc::Reflectance(Rgb::splat(0.9))),
+        MaterialDesc::Dielectric { eta: 1.5 },
+        MaterialDesc::RoughConductor {
+            conductor: ConductorDesc::Reflectance(Rgb::splat(0.9)),
+            alpha_u: 0.3,
+            alpha_v: 0.1,
+        },
+        MaterialDesc::RoughDielectric {
+            eta: 1.5,
+            alpha_u: 0.3,
+            alpha_v: 0.3,
+        },
+        MaterialDesc::ThinDielectric { eta: 1.5 },
+        MaterialDesc::DiffuseTransmission {
+            reflectance: grey,
+            transmittance: grey,
+        },
+    ];
+    let mut materials: Vec<Material> = descs.iter().map(Material::from_desc).collect();
+    materials.push(Material::Conductor {
+        eta: Rgb::splat(0.2),
+        k: Rgb::splat(3.9),
+    });
+    materials.push(Material::Interface);
+    let mut rng = Pcg32::new(11, 0);
+    for m in materials {
+        let mut differs = false;
+        for _ in 0..200 {
+            let wo = random_dir(&mut rng);
+            let u2 = Vec2::new(rng.uniform(), rng.uniform());
+            let sample = |u1: f32| {
+                m.sample(wo, u1, u2, TransportMode::Radiance)
+                    .map(|s| (s.wi, s.f, s.pdf, s.specular))
+            };
+            let at_zero = sample(0.0);
+            for u1 in [0.03f32, 0.5, 0.97] {
+                if sample(u1) != at_zero {
+                    differs = true;
+                    assert!(m.uses_lobe_sample(), "{m:?} reads u1 but says it does not");
+                }
+            }
+        }
+        assert_eq!(differs, m.uses_lobe_sample(), "{m:?}");
+    }
+}

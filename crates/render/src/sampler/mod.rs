@@ -168,6 +168,18 @@ impl PixelSample {
         self.get_2d_other()
     }
 
+    /// [`get_2d`](Self::get_2d) when `needed`; otherwise (0, 0) without computing the
+    /// pair, the dimension consumed either way (as [`get_1d_if`](Self::get_1d_if)).
+    #[inline]
+    pub fn get_2d_if(&mut self, needed: bool) -> Vec2 {
+        if needed {
+            self.get_2d()
+        } else {
+            self.dim += 1;
+            Vec2::ZERO
+        }
+    }
+
     #[inline(never)]
     fn get_2d_other(&mut self) -> Vec2 {
         let dim = self.dim;
@@ -246,6 +258,34 @@ mod tests {
                     .collect();
                 assert!(is_02_net(&pts), "pair {dim_pair} pixel ({x},{y})");
             }
+        }
+    }
+
+    /// A skipped draw consumes its dimension: what follows is the same as after a real one.
+    #[test]
+    fn skipped_draws_keep_the_dimensions_that_follow() {
+        let kinds = [
+            SamplerKind::Sobol,
+            SamplerKind::Independent,
+            SamplerKind::Halton {
+                randomization: radiant_scene::DigitRandomization::PermuteDigits,
+            },
+            SamplerKind::Stratified {
+                x: 4,
+                y: 4,
+                jitter: true,
+            },
+        ];
+        for kind in kinds {
+            let mut drawn = PixelSample::new(kind, 3, 4, 5, 6);
+            let mut skipped = drawn.clone();
+            let (a, b) = (drawn.get_2d(), drawn.get_1d());
+            assert_eq!(skipped.get_2d_if(false), Vec2::ZERO);
+            assert_eq!(skipped.get_1d_if(false), 0.0);
+            assert_ne!((a, b), (Vec2::ZERO, 0.0));
+            assert_eq!(drawn.get_2d(), skipped.get_2d(), "{kind:?}");
+            assert_eq!(drawn.get_1d_if(true), skipped.get_1d(), "{kind:?}");
+            assert_eq!(drawn.get_2d_if(true), skipped.get_2d(), "{kind:?}");
         }
     }
 

@@ -194,7 +194,7 @@ fn final_gather(
     let mut sum = Rgb::BLACK;
     for j in 0..n {
         let mut s = PixelSample::for_stream(gather.kind, gather.seed, gather.key, j);
-        let u_lobe = s.get_1d();
+        let u_lobe = s.get_1d_if(material.uses_lobe_sample());
         let u_dir = s.get_2d();
         let Some(bs) = material.sample(wo, u_lobe, u_dir, TransportMode::Radiance) else {
             continue;

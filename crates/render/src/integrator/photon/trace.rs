@@ -148,7 +148,7 @@ pub fn trace_photon(
         }
         let frame = World::shading_frame(&hit, &material);
         let wo = frame.to_local(wo_world);
-        let u_lobe = sampler.get_1d();
+        let u_lobe = sampler.get_1d_if(material.uses_lobe_sample());
         let u_dir = sampler.get_2d();
         let u_rr = sampler.get_1d();
         let Some(bs) = material.sample(wo, u_lobe, u_dir, TransportMode::Importance) else {
