@@ -38,10 +38,11 @@ pub enum Visualize {
 pub struct PhotonSettings {
     /// `"integer photons" [200000]`: photons emitted for the global (indirect) map.
     pub photons: u32,
-    /// `"integer causticphotons" [500000]`: photons emitted for the caustic map (aimed
-    /// at specular objects when `projectionmaps` is on).
+    /// `"integer causticphotons" [2000000]`: photons emitted for the caustic map (aimed
+    /// at specular objects when `projectionmaps` is on). See [`PhotonSettings::default`]
+    /// for how this, `lookup` and `finalgathersamples` were chosen.
     pub caustic_photons: u32,
-    /// `"integer lookup" [100]`: photons in a caustic radiance estimate (k nearest).
+    /// `"integer lookup" [50]`: photons in a caustic radiance estimate (k nearest).
     pub lookup: u32,
     /// `"integer globallookup" [200]`: photons in each precomputed irradiance estimate
     /// of the global map.
@@ -49,7 +50,7 @@ pub struct PhotonSettings {
     /// `"float maxradius"` (scene units; default 1/20 of the scene's bounding-sphere
     /// radius): the largest search radius of any estimate.
     pub max_radius: Option<f32>,
-    /// `"integer finalgathersamples" [64]`: gather rays per camera sample at the first
+    /// `"integer finalgathersamples" [8]`: gather rays per camera sample at the first
     /// diffuse vertex (0 turns final gathering off: the global map is read directly).
     pub final_gather_samples: u32,
     /// `"bool projectionmaps" [true]`: aim caustic photons only at specular objects.
@@ -66,15 +67,25 @@ pub struct PhotonSettings {
     pub seed: Option<u64>,
 }
 
+/// The defaults were chosen by CPU time to error on cornell-caustics (docs/speed.md,
+/// 256 × 256, two seeds and more, against the reference). The caustic estimate's blur
+/// is a bias that no number of camera samples removes: its squared relative error on
+/// the caustic crop grows as `lookup` / `causticphotons` (4.5e-3 at 100 / 500k, above
+/// the crop's 4e-3 target on its own; 0.8e-3 at 50 / 2M, for about 1.2 CPU-s more
+/// photon tracing). What remains is camera-side noise, about (0.085 + 0.19 / FG) / spp
+/// on the crop and (0.015 + 0.072 / FG) / spp on the whole image, against a cost of
+/// about (0.55 + 0.058 FG) CPU-s per sample per pixel of the 256² image: 6 to 8 gather
+/// rays minimise time to either error (64 made each sample four times dearer for
+/// little), and 0 is both slower (each camera sample reads the global map) and biased.
 impl Default for PhotonSettings {
     fn default() -> Self {
         PhotonSettings {
             photons: 200_000,
-            caustic_photons: 500_000,
-            lookup: 100,
+            caustic_photons: 2_000_000,
+            lookup: 50,
             global_lookup: 200,
             max_radius: None,
-            final_gather_samples: 64,
+            final_gather_samples: 8,
             projection_maps: true,
             max_depth: 5,
             kernel: Kernel::Cone,
@@ -88,8 +99,8 @@ impl PhotonSettings {
     /// Reads the parameters; `visualize_default` is `Density` for the `photonviz` name.
     ///
     /// ```text
-    /// Integrator "photonmap" "integer photons" [200000] "integer causticphotons" [500000]
-    ///     "integer lookup" [100] "float maxradius" [25] "integer finalgathersamples" [64]
+    /// Integrator "photonmap" "integer photons" [200000] "integer causticphotons" [2000000]
+    ///     "integer lookup" [50] "float maxradius" [25] "integer finalgathersamples" [8]
     ///     "bool projectionmaps" [true] "integer maxdepth" [5] "string kernel" ["cone"]
     ///     "string visualize" ["none"]
     /// ```
