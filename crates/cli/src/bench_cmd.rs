@@ -47,51 +47,51 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     pool.install(|| {
         let reps = if args.quick { 2 } else { 5 };
         let size = if args.quick { 256 } else { 1024 };
-        println!("== rays through the world, cornell-box (36 triangles), {size}x{size} camera");
-        println!("{}", world_ray_benchmark(&cornell_box(), size, reps));
-        println!("== rays, displaced sphere of ~1M triangles inside the Cornell box");
+        out!("== rays through the world, cornell-box (36 triangles), {size}x{size} camera");
+        out!("{}", world_ray_benchmark(&cornell_box(), size, reps));
+        out!("== rays, displaced sphere of ~1M triangles inside the Cornell box");
         let config = RayBenchConfig {
             subdivision: if args.quick { 64 } else { 224 },
             image_size: if args.quick { 256 } else { 1024 },
             repetitions: reps,
             ..Default::default()
         };
-        println!("{}", ray_benchmark(&config));
-        println!(
+        out!("{}", ray_benchmark(&config));
+        out!(
             "== render cornell-box 256x256, {} spp, path tracer",
             args.spp
         );
         let (seconds, _) = render_benchmark(&cornell_box(), args.spp);
-        println!(
+        out!(
             "{seconds:.2} s wall on {} threads",
             rayon::current_num_threads()
         );
-        println!("== render bitterli/teapot at its resolution, 64 spp, path tracer");
+        out!("== render bitterli/teapot at its resolution, 64 spp, path tracer");
         match teapot_scene() {
             Some(path) => match radiant::scene::parse_file(&path) {
                 Ok(desc) => {
                     let (seconds, _) = render_benchmark(&desc, 64);
-                    println!(
+                    out!(
                         "{seconds:.2} s wall on {} threads",
                         rayon::current_num_threads()
                     );
                 }
-                Err(e) => println!("skipped: {e}"),
+                Err(e) => out!("skipped: {e}"),
             },
-            None => println!(
+            None => out!(
                 "skipped: bitterli/teapot not found (set RADIANT_SHARED to the shared data folder)"
             ),
         }
-        println!("== environment light sampling, sky with a small sun");
-        println!(
+        out!("== environment light sampling, sky with a small sun");
+        out!(
             "{}",
             environment_benchmark(512, if args.quick { 200_000 } else { 2_000_000 })
         );
-        println!("== photon mapping, cornell-caustics");
-        println!("{}", photon_benchmark(args.quick));
-        println!("== image texture lookups, 1024x1024 pyramid, anisotropic footprints");
+        out!("== photon mapping, cornell-caustics");
+        out!("{}", photon_benchmark(args.quick));
+        out!("== image texture lookups, 1024x1024 pyramid, anisotropic footprints");
         let lookups = if args.quick { 200_000 } else { 2_000_000 };
-        println!("{}", texture_lookup_benchmark(lookups, reps));
+        out!("{}", texture_lookup_benchmark(lookups, reps));
     });
     Ok(())
 }
@@ -225,7 +225,7 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
             max_spp: 128,
         },
     ];
-    println!(
+    out!(
         "== time to error: CPU seconds (user + system, whole process), {} threads, seeds 1..={seeds}",
         rayon::current_num_threads()
     );
@@ -248,7 +248,7 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
             times.push(t);
             spps.push(n);
         }
-        println!(
+        out!(
             "{}: median {:.1} CPU-s, {:.0} {}  [{}]",
             task.label,
             median(times),
@@ -272,7 +272,7 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
         session.render(&Progress::default());
         per_256.push(cpu_seconds() - start);
     }
-    println!(
+    out!(
         "cornell-box, path, 256 spp at Mitsuba 3's Russian roulette (rrdepth 4, rrthreshold 1): median {:.1} CPU-s  [{}]",
         median(per_256.clone()),
         per_256

@@ -105,7 +105,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         if let Some(f) = &flip {
             fields.push(format!("\"flip_mean\": {}", json_number(f.flip_mean)));
         }
-        println!("{{{}}}", fields.join(", "));
+        out!("{{{}}}", fields.join(", "));
     } else {
         for (name, v) in [
             ("rmse", m.rmse),
@@ -114,14 +114,14 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
             ("mean_test", m.mean_test),
             ("mean_ref", m.mean_ref),
         ] {
-            println!("{name} {}", format_g(v, 6));
+            out!("{name} {}", format_g(v, 6));
         }
-        println!("nonfinite {}", m.nonfinite);
+        out!("nonfinite {}", m.nonfinite);
         if let Some(s) = diff_scale {
-            println!("diff_scale {}", format_g(s as f64, 6));
+            out!("diff_scale {}", format_g(s as f64, 6));
         }
         if let Some(f) = &flip {
-            println!("flip_mean {}", format_g(f.flip_mean, 6));
+            out!("flip_mean {}", format_g(f.flip_mean, 6));
         }
     }
     Ok(())

@@ -77,10 +77,10 @@ pub fn run(args: LensArgs) -> anyhow::Result<()> {
     )?;
     let pupil_time = start.elapsed();
 
-    print!("{}", lens_report(&camera, Some(pupil_time)));
+    out_part!("{}", lens_report(&camera, Some(pupil_time)));
     if args.rays > 0 {
         let (rays_per_second, passed) = measure_ray_throughput(&camera, args.rays);
-        println!(
+        out!(
             "camera rays: {:.2} M/s on one thread ({:.1} % of {} samples passed the lens)",
             rays_per_second * 1e-6,
             100.0 * passed as f64 / args.rays as f64,
@@ -90,7 +90,7 @@ pub fn run(args: LensArgs) -> anyhow::Result<()> {
     if let Some(path) = &args.svg {
         radiant::image::atomic::atomic_write_bytes(path, lens_svg(&camera).as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
-        println!("cross-section written to {}", path.display());
+        out!("cross-section written to {}", path.display());
     }
     Ok(())
 }

@@ -1,5 +1,27 @@
 //! The `radiant` command line: a thin layer over the library.
 
+/// `println!` for the commands' reports. Standard output closed by its reader
+/// (`radiant compare a b | head -1`) ends the process quietly instead of panicking, as
+/// `println!` does; whatever the command wrote to files is already complete.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stdout(), $($arg)*) {
+            $crate::stdout_failed(e)
+        }
+    }};
+}
+
+/// `print!` with [`out!`]'s handling of a closed standard output.
+macro_rules! out_part {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = write!(std::io::stdout(), $($arg)*) {
+            $crate::stdout_failed(e)
+        }
+    }};
+}
+
 mod bench_cmd;
 mod compare_cmd;
 mod lens_cmd;
@@ -88,4 +110,14 @@ fn main() {
         eprintln!("radiant: {e:#}");
         std::process::exit(1);
     }
+}
+
+/// Standard output could not be written: a reader that stopped reading (a closed pipe)
+/// ends the process with success, anything else is an error.
+fn stdout_failed(e: std::io::Error) -> ! {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        std::process::exit(0);
+    }
+    eprintln!("radiant: writing to standard output: {e}");
+    std::process::exit(1);
 }

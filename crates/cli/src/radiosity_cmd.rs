@@ -458,7 +458,7 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
             solution.factor_seconds
         );
     }
-    println!("{}", solution.balance.summary());
+    out!("{}", solution.balance.summary());
     if let Some(path) = &args.save_solution
         && !solution.interrupted
     {

@@ -485,7 +485,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             .stats
             .get::<radiant::render::integrator::PhotonMapStats>()
             .map(|s| s.global_stored + s.caustic_stored);
-        print!(
+        out_part!(
             "{}",
             crate::pbrt_opts::format_stats(&counts, photons, &memory, &times)
         );

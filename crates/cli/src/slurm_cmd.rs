@@ -176,10 +176,10 @@ pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
         radiant::image::atomic::atomic_write_bytes(path, text.as_bytes())
             .with_context(|| format!("writing {}", path.display()))?;
     }
-    println!("array job: {}", array_path.display());
-    println!("merge job: {}", merge_path.display());
+    out!("array job: {}", array_path.display());
+    out!("merge job: {}", merge_path.display());
     if !args.submit {
-        println!(
+        out!(
             "submit with: id=$(sbatch --parsable {}) && sbatch --dependency=afterok:$id {}",
             array_path.display(),
             merge_path.display()
@@ -206,6 +206,6 @@ pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
     };
     let array_id = sbatch(&[], &array_path)?;
     let merge_id = sbatch(&[format!("--dependency=afterok:{array_id}")], &merge_path)?;
-    println!("submitted array job {array_id} ({n} tasks), merge job {merge_id}");
+    out!("submitted array job {array_id} ({n} tasks), merge job {merge_id}");
     Ok(())
 }

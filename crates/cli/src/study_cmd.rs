@@ -175,13 +175,20 @@ pub fn run(args: StudyArgs) -> anyhow::Result<()> {
         .with_context(|| format!("writing {}", args.output.display()))?;
 
     let slope = |s: Option<f64>| s.map_or_else(|| "-".to_string(), |v| format!("{v:.3}"));
-    println!(
+    out!(
         "{:<16} {:>9} {:>9} {:>12} {:>12} {:>10} {:>12} {:>12}",
-        "method", "samples", "time_s", "relmse", "rmse", "flip", "slope_spp", "slope_time"
+        "method",
+        "samples",
+        "time_s",
+        "relmse",
+        "rmse",
+        "flip",
+        "slope_spp",
+        "slope_time"
     );
     for r in &study.runs {
         let m = &r.measured.metrics;
-        println!(
+        out!(
             "{:<16} {:>9} {:>9.2} {:>12.5e} {:>12.5e} {:>10.5} {:>12} {:>12}",
             r.integrator,
             r.samples,

@@ -117,3 +117,39 @@ fn failures_exit_nonzero_and_name_the_file() {
     ]);
     assert!(!ok && stderr.contains("crop"), "{stderr}");
 }
+
+/// A reader that stops reading (`radiant compare a b | head -1`) ends the command
+/// quietly with success, not with a panic; a standard output that cannot be written
+/// for another reason is a clear error.
+#[test]
+fn a_closed_standard_output_is_not_a_panic() {
+    let image = refs().join("cornell-box-256-ref.exr");
+    let image = image.to_str().unwrap();
+    let (reader, writer) = std::io::pipe().expect("a pipe");
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_radiant"))
+        .args(["compare", image, image])
+        .env("RUST_BACKTRACE", "0")
+        .stdout(writer)
+        .output()
+        .expect("radiant binary runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{:?}: {stderr}", out.status);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    if std::path::Path::new("/dev/full").exists() {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .expect("/dev/full opens");
+        let out = Command::new(env!("CARGO_BIN_EXE_radiant"))
+            .args(["compare", image, image])
+            .env("RUST_BACKTRACE", "0")
+            .stdout(full)
+            .output()
+            .expect("radiant binary runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(stderr.contains("standard output"), "{stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}
