@@ -22,11 +22,32 @@ use glam::Vec4;
 /// Proof that this processor runs AVX: only [`Avx::detect`] makes one. Every `unsafe`
 /// below is a call into AVX code, sound because one of these exists.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Avx(());
+pub(crate) struct Avx {
+    evex: bool,
+}
 
 impl Avx {
     pub fn detect() -> Option<Avx> {
-        std::arch::is_x86_feature_detected!("avx").then_some(Avx(()))
+        std::arch::is_x86_feature_detected!("avx").then(|| Avx {
+            evex: std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("avx512f")
+                && std::arch::is_x86_feature_detected!("avx512vl"),
+        })
+    }
+
+    /// Whether the processor also has AVX2, AVX-512F and AVX-512VL, so that the same
+    /// 256-bit kernels may be compiled with the EVEX encoding: 32 vector registers
+    /// instead of 16 (the per-ray constants of a traversal no longer spill to the
+    /// stack) and one-instruction broadcasts. The operations, hence the hits, are the
+    /// same bit for bit.
+    pub fn evex(&self) -> bool {
+        self.evex
+    }
+
+    /// This proof without the EVEX kernels (for tests that compare them).
+    #[cfg(test)]
+    pub fn without_evex(self) -> Avx {
+        Avx { evex: false }
     }
 }
 

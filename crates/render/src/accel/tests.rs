@@ -117,7 +117,7 @@ fn triangle_bvh_and_generic_bvh_equal_brute_force() {
     assert!(checked_hits > 4500, "{checked_hits}");
 }
 
-/// The 8-lane AVX kernels and the 4-lane ones must report the same hit, bit for bit
+/// The 8-lane AVX kernels (in both encodings) and the 4-lane ones must report the same hit, bit for bit
 /// (distance, triangle on ties, barycentrics), and the same occlusion: on the edge-case
 /// soups, where rays run through edges, vertices and face planes, and on a closed mesh.
 #[test]
@@ -140,6 +140,11 @@ fn avx_and_sse_kernels_give_identical_hits() {
         let wide = TriangleBvh::from_soup(tris);
         let narrow = wide.clone().without_avx();
         assert!(!narrow.uses_avx());
+        #[cfg(target_arch = "x86_64")]
+        let vex = wide.clone().without_evex();
+        #[cfg(not(target_arch = "x86_64"))]
+        let vex = wide.clone();
+        assert!(!vex.uses_evex());
         let mut queries = rays(&mut rng, tris, 3000);
         // Rays from inside the sphere too, so that closest hits lie behind other leaves.
         queries.extend((0..500).map(|_| Ray::new((rv(&mut rng) - 0.5) * 0.5, rv(&mut rng) - 0.5)));
@@ -147,14 +152,18 @@ fn avx_and_sse_kernels_give_identical_hits() {
             for t_max in [f32::INFINITY, 3.0, 0.5] {
                 let (a, b) = (wide.intersect(ray, t_max), narrow.intersect(ray, t_max));
                 assert_eq!(a, b, "{ray:?} t_max {t_max}");
+                assert_eq!(vex.intersect(ray, t_max), b, "{ray:?} t_max {t_max}");
                 hits += usize::from(a.is_some());
                 assert_eq!(wide.occluded(ray, t_max), narrow.occluded(ray, t_max));
+                assert_eq!(vex.occluded(ray, t_max), narrow.occluded(ray, t_max));
             }
         }
     }
     assert!(hits > 10_000, "{hits}");
     if !TriangleBvh::from_soup(&scenes[0]).uses_avx() {
         eprintln!("this processor has no AVX: only the 4-lane kernels were compared");
+    } else if !TriangleBvh::from_soup(&scenes[0]).uses_evex() {
+        eprintln!("this processor has no AVX-512VL: the EVEX kernels were not compared");
     }
 }
 

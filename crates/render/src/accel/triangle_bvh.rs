@@ -123,6 +123,24 @@ impl TriangleBvh {
         }
     }
 
+    /// The same tree queried with the AVX kernels in their VEX encoding only (for tests
+    /// that compare them with the EVEX one).
+    #[cfg(all(test, target_arch = "x86_64"))]
+    pub(crate) fn without_evex(self) -> TriangleBvh {
+        TriangleBvh {
+            avx: self.avx.map(Avx::without_evex),
+            ..self
+        }
+    }
+
+    /// Whether queries use the 8-lane AVX kernels compiled with the EVEX encoding.
+    pub fn uses_evex(&self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        return self.avx.is_some_and(|a| a.evex());
+        #[cfg(not(target_arch = "x86_64"))]
+        return false;
+    }
+
     /// Whether queries use the 8-lane AVX kernels.
     pub fn uses_avx(&self) -> bool {
         #[cfg(target_arch = "x86_64")]
@@ -145,12 +163,28 @@ impl TriangleBvh {
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<MeshHit> {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx) = self.avx {
-            // SAFETY: `avx` proves that this processor runs AVX code.
+            // SAFETY: `avx` proves that this processor runs AVX code, and AVX2,
+            // AVX-512F and AVX-512VL code where `avx.evex()`.
             #[allow(unsafe_code)]
-            return match self.nodes.stack() {
-                StackSize::Tiny => unsafe { self.intersect_avx::<TINY_STACK>(avx, ray, t_max) },
-                StackSize::Small => unsafe { self.intersect_avx::<SMALL_STACK>(avx, ray, t_max) },
-                StackSize::Large => unsafe { self.intersect_avx::<LARGE_STACK>(avx, ray, t_max) },
+            return match (self.nodes.stack(), avx.evex()) {
+                (StackSize::Tiny, false) => unsafe {
+                    self.intersect_avx::<TINY_STACK>(avx, ray, t_max)
+                },
+                (StackSize::Small, false) => unsafe {
+                    self.intersect_avx::<SMALL_STACK>(avx, ray, t_max)
+                },
+                (StackSize::Large, false) => unsafe {
+                    self.intersect_avx::<LARGE_STACK>(avx, ray, t_max)
+                },
+                (StackSize::Tiny, true) => unsafe {
+                    self.intersect_evex::<TINY_STACK>(avx, ray, t_max)
+                },
+                (StackSize::Small, true) => unsafe {
+                    self.intersect_evex::<SMALL_STACK>(avx, ray, t_max)
+                },
+                (StackSize::Large, true) => unsafe {
+                    self.intersect_evex::<LARGE_STACK>(avx, ray, t_max)
+                },
             };
         }
         match self.nodes.stack() {
@@ -183,6 +217,31 @@ impl TriangleBvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     fn intersect_avx<const STACK: usize>(
+        &self,
+        avx: Avx,
+        ray: &Ray,
+        t_max: f32,
+    ) -> Option<MeshHit> {
+        self.intersect_wide::<STACK>(avx, ray, t_max)
+    }
+
+    /// The same, compiled with the EVEX encoding (see [`Avx::evex`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
+    fn intersect_evex<const STACK: usize>(
+        &self,
+        avx: Avx,
+        ray: &Ray,
+        t_max: f32,
+    ) -> Option<MeshHit> {
+        self.intersect_wide::<STACK>(avx, ray, t_max)
+    }
+
+    /// The 8-lane closest-hit query, inlined into the functions above, which choose the
+    /// instruction set it is compiled for.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn intersect_wide<const STACK: usize>(
         &self,
         avx: Avx,
         ray: &Ray,
@@ -276,6 +335,20 @@ impl TriangleBvh {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     fn occluded_avx<const STACK: usize>(&self, avx: Avx, ray: &Ray, t_max: f32) -> bool {
+        self.occluded_wide::<STACK>(avx, ray, t_max)
+    }
+
+    /// The same, compiled with the EVEX encoding (see [`Avx::evex`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2,avx512f,avx512vl")]
+    fn occluded_evex<const STACK: usize>(&self, avx: Avx, ray: &Ray, t_max: f32) -> bool {
+        self.occluded_wide::<STACK>(avx, ray, t_max)
+    }
+
+    /// The 8-lane any-hit query, inlined into the functions above.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn occluded_wide<const STACK: usize>(&self, avx: Avx, ray: &Ray, t_max: f32) -> bool {
         let wr = WatertightRay8::new(&WatertightRay::new(ray), avx);
         let mut leaves = AnyBlock8 {
             bvh: self,
@@ -348,12 +421,27 @@ impl TriangleBvh {
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx) = self.avx {
-            // SAFETY: `avx` proves that this processor runs AVX code.
+            // SAFETY: as for `intersect`.
             #[allow(unsafe_code)]
-            return match self.nodes.stack() {
-                StackSize::Tiny => unsafe { self.occluded_avx::<TINY_STACK>(avx, ray, t_max) },
-                StackSize::Small => unsafe { self.occluded_avx::<SMALL_STACK>(avx, ray, t_max) },
-                StackSize::Large => unsafe { self.occluded_avx::<LARGE_STACK>(avx, ray, t_max) },
+            return match (self.nodes.stack(), avx.evex()) {
+                (StackSize::Tiny, false) => unsafe {
+                    self.occluded_avx::<TINY_STACK>(avx, ray, t_max)
+                },
+                (StackSize::Small, false) => unsafe {
+                    self.occluded_avx::<SMALL_STACK>(avx, ray, t_max)
+                },
+                (StackSize::Large, false) => unsafe {
+                    self.occluded_avx::<LARGE_STACK>(avx, ray, t_max)
+                },
+                (StackSize::Tiny, true) => unsafe {
+                    self.occluded_evex::<TINY_STACK>(avx, ray, t_max)
+                },
+                (StackSize::Small, true) => unsafe {
+                    self.occluded_evex::<SMALL_STACK>(avx, ray, t_max)
+                },
+                (StackSize::Large, true) => unsafe {
+                    self.occluded_evex::<LARGE_STACK>(avx, ray, t_max)
+                },
             };
         }
         match self.nodes.stack() {
