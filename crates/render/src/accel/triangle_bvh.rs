@@ -51,6 +51,18 @@ const SETTINGS: BuildSettings = BuildSettings {
     cost_traversal: 1.0,
 };
 
+/// `$self.$query::<STACK>(args)` with the traversal stack the tree needs: each stack size
+/// is its own monomorphised query, chosen once per query.
+macro_rules! by_stack {
+    ($self:ident, $query:ident($($arg:expr),*)) => {
+        match $self.nodes.stack() {
+            StackSize::Tiny => $self.$query::<TINY_STACK>($($arg),*),
+            StackSize::Small => $self.$query::<SMALL_STACK>($($arg),*),
+            StackSize::Large => $self.$query::<LARGE_STACK>($($arg),*),
+        }
+    };
+}
+
 impl TriangleBvh {
     /// Builds over `triangles` (vertex indices into `vertices`). Triangles with an index
     /// out of range or a non-finite vertex are left out (mesh loaders report those);
@@ -166,32 +178,15 @@ impl TriangleBvh {
             // SAFETY: `avx` proves that this processor runs AVX code, and AVX2,
             // AVX-512F and AVX-512VL code where `avx.evex()`.
             #[allow(unsafe_code)]
-            return match (self.nodes.stack(), avx.evex()) {
-                (StackSize::Tiny, false) => unsafe {
-                    self.intersect_avx::<TINY_STACK>(avx, ray, t_max)
-                },
-                (StackSize::Small, false) => unsafe {
-                    self.intersect_avx::<SMALL_STACK>(avx, ray, t_max)
-                },
-                (StackSize::Large, false) => unsafe {
-                    self.intersect_avx::<LARGE_STACK>(avx, ray, t_max)
-                },
-                (StackSize::Tiny, true) => unsafe {
-                    self.intersect_evex::<TINY_STACK>(avx, ray, t_max)
-                },
-                (StackSize::Small, true) => unsafe {
-                    self.intersect_evex::<SMALL_STACK>(avx, ray, t_max)
-                },
-                (StackSize::Large, true) => unsafe {
-                    self.intersect_evex::<LARGE_STACK>(avx, ray, t_max)
-                },
+            return unsafe {
+                if avx.evex() {
+                    by_stack!(self, intersect_evex(avx, ray, t_max))
+                } else {
+                    by_stack!(self, intersect_avx(avx, ray, t_max))
+                }
             };
         }
-        match self.nodes.stack() {
-            StackSize::Tiny => self.intersect_with::<TINY_STACK>(ray, t_max),
-            StackSize::Small => self.intersect_with::<SMALL_STACK>(ray, t_max),
-            StackSize::Large => self.intersect_with::<LARGE_STACK>(ray, t_max),
-        }
+        by_stack!(self, intersect_with(ray, t_max))
     }
 
     #[inline(always)]
@@ -423,32 +418,15 @@ impl TriangleBvh {
         if let Some(avx) = self.avx {
             // SAFETY: as for `intersect`.
             #[allow(unsafe_code)]
-            return match (self.nodes.stack(), avx.evex()) {
-                (StackSize::Tiny, false) => unsafe {
-                    self.occluded_avx::<TINY_STACK>(avx, ray, t_max)
-                },
-                (StackSize::Small, false) => unsafe {
-                    self.occluded_avx::<SMALL_STACK>(avx, ray, t_max)
-                },
-                (StackSize::Large, false) => unsafe {
-                    self.occluded_avx::<LARGE_STACK>(avx, ray, t_max)
-                },
-                (StackSize::Tiny, true) => unsafe {
-                    self.occluded_evex::<TINY_STACK>(avx, ray, t_max)
-                },
-                (StackSize::Small, true) => unsafe {
-                    self.occluded_evex::<SMALL_STACK>(avx, ray, t_max)
-                },
-                (StackSize::Large, true) => unsafe {
-                    self.occluded_evex::<LARGE_STACK>(avx, ray, t_max)
-                },
+            return unsafe {
+                if avx.evex() {
+                    by_stack!(self, occluded_evex(avx, ray, t_max))
+                } else {
+                    by_stack!(self, occluded_avx(avx, ray, t_max))
+                }
             };
         }
-        match self.nodes.stack() {
-            StackSize::Tiny => self.occluded_with::<TINY_STACK>(ray, t_max),
-            StackSize::Small => self.occluded_with::<SMALL_STACK>(ray, t_max),
-            StackSize::Large => self.occluded_with::<LARGE_STACK>(ray, t_max),
-        }
+        by_stack!(self, occluded_with(ray, t_max))
     }
 
     #[inline(always)]
