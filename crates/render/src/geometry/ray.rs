@@ -49,29 +49,6 @@ pub const fn gamma(n: i32) -> f32 {
     (n as f32 * MACHINE_EPSILON) / (1.0 - n as f32 * MACHINE_EPSILON)
 }
 
-/// The smallest float greater than `x` (`x` itself for +∞ and NaN).
-#[inline]
-pub fn next_float_up(x: f32) -> f32 {
-    if x.is_nan() || x == f32::INFINITY {
-        return x;
-    }
-    // -0 and +0 both step to the smallest positive subnormal.
-    let x = if x == -0.0 { 0.0 } else { x };
-    let bits = x.to_bits();
-    f32::from_bits(if x >= 0.0 { bits + 1 } else { bits - 1 })
-}
-
-/// The largest float less than `x` (`x` itself for −∞ and NaN).
-#[inline]
-pub fn next_float_down(x: f32) -> f32 {
-    if x.is_nan() || x == f32::NEG_INFINITY {
-        return x;
-    }
-    let x = if x == 0.0 { -0.0 } else { x };
-    let bits = x.to_bits();
-    f32::from_bits(if x > 0.0 { bits - 1 } else { bits + 1 })
-}
-
 /// A point on a surface (or in free space) as a place rays start from or end at: the
 /// computed position, a conservative bound on its error per component, and the geometric
 /// normal (either orientation; zero for points in free space, which are not moved).
@@ -179,20 +156,6 @@ pub fn transform_point_with_error(xf: &Transform, p: Vec3, p_error: Vec3) -> (Ve
 mod tests {
     use super::*;
     use radiant_math::hash::Pcg32;
-
-    #[test]
-    fn next_float_steps_one_ulp() {
-        for x in [1.0f32, -1.0, 0.0, -0.0, 1e-30, -3.5e7, f32::MAX * 0.5] {
-            let up = next_float_up(x);
-            let down = next_float_down(x);
-            assert!(up > x && down < x, "{x}");
-            // Nothing lies strictly between.
-            assert_eq!(next_float_down(up), if x == 0.0 { 0.0 } else { x });
-            assert_eq!(next_float_up(down), if x == 0.0 { 0.0 } else { x });
-        }
-        assert_eq!(next_float_up(f32::INFINITY), f32::INFINITY);
-        assert_eq!(next_float_down(f32::NEG_INFINITY), f32::NEG_INFINITY);
-    }
 
     #[test]
     fn offset_moves_to_the_side_of_w_past_the_error_box() {
