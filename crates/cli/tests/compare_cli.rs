@@ -125,14 +125,17 @@ fn failures_exit_nonzero_and_name_the_file() {
 fn a_closed_standard_output_is_not_a_panic() {
     let image = refs().join("cornell-box-256-ref.exr");
     let image = image.to_str().unwrap();
+    let compare_into = |stdout: std::process::Stdio| {
+        Command::new(env!("CARGO_BIN_EXE_radiant"))
+            .args(["compare", image, image])
+            .env("RUST_BACKTRACE", "0")
+            .stdout(stdout)
+            .output()
+            .expect("radiant binary runs")
+    };
     let (reader, writer) = std::io::pipe().expect("a pipe");
     drop(reader);
-    let out = Command::new(env!("CARGO_BIN_EXE_radiant"))
-        .args(["compare", image, image])
-        .env("RUST_BACKTRACE", "0")
-        .stdout(writer)
-        .output()
-        .expect("radiant binary runs");
+    let out = compare_into(writer.into());
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{:?}: {stderr}", out.status);
     assert!(!stderr.contains("panicked"), "{stderr}");
@@ -141,12 +144,7 @@ fn a_closed_standard_output_is_not_a_panic() {
             .write(true)
             .open("/dev/full")
             .expect("/dev/full opens");
-        let out = Command::new(env!("CARGO_BIN_EXE_radiant"))
-            .args(["compare", image, image])
-            .env("RUST_BACKTRACE", "0")
-            .stdout(full)
-            .output()
-            .expect("radiant binary runs");
+        let out = compare_into(full.into());
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{stderr}");
         assert!(stderr.contains("standard output"), "{stderr}");

@@ -154,13 +154,9 @@ fn default_settings_resolve_the_caustic_crop() {
         samples: (0, 64),
     };
     let img = session.render(&Progress::default()).film.image();
-    let full = reference(256);
-    let mut expected = Image::new(x1 - x0, y1 - y0);
-    for y in y0..y1 {
-        for x in x0..x1 {
-            expected.pixels[(y - y0) * (x1 - x0) + (x - x0)] = full.pixels[y * 256 + x];
-        }
-    }
+    let expected = reference(256)
+        .crop(crop_at(CAUSTIC_CROP, 256))
+        .expect("the crop lies in the image");
     let metrics = compare(&img, &expected, None).unwrap();
     eprintln!("caustic crop relMSE {}", metrics.relmse);
     assert!(
