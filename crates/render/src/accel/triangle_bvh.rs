@@ -16,12 +16,13 @@ use glam::Vec3;
 
 /// A closest hit on a [`TriangleBvh`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(16))]
 pub struct MeshHit {
+    /// Barycentric weights of the triangle's three vertices at the hit.
+    pub b: [f32; 3],
     pub t: f32,
     /// Index of the triangle in the list given to the build.
     pub prim: u32,
-    /// Barycentric weights of the triangle's three vertices at the hit.
-    pub b: [f32; 3],
 }
 
 /// A BVH over triangles that owns a leaf-ordered copy of their vertices.

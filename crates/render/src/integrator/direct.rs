@@ -117,9 +117,7 @@ pub fn sample_direct(
     };
     let hit = at.hit;
     let mut ctx = hit.light_sample_context();
-    if at.mis_with_bsdf {
-        ctx = ctx.with_mis();
-    }
+    ctx.mis_with_bsdf = at.mis_with_bsdf;
     let Some(chosen) = world.light_sampler.sample(&ctx, u_choice) else {
         return out;
     };

@@ -247,7 +247,12 @@ pub fn radiance(
         }
         specular_bounce = bs.specular;
         prev_pdf = bs.pdf;
-        prev_ctx = hit.light_sample_context().with_mis();
+        // Field by field: a whole new context went through a stack temporary that was
+        // read back in wider words than it was written (a store-forwarding stall).
+        prev_ctx.p = hit.p;
+        prev_ctx.n = hit.ng;
+        prev_ctx.ns = hit.ns;
+        prev_ctx.mis_with_bsdf = true;
         ray = hit.spawn_ray(wi);
 
         let rr_beta = beta.max_component() * eta_scale / settings.rr_threshold;

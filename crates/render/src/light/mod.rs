@@ -64,12 +64,14 @@ impl LightSampleContext {
         }
     }
 
-    /// The same receiver, for light samples that MIS combines with BSDF samples.
-    pub fn with_mis(self) -> LightSampleContext {
-        LightSampleContext {
-            mis_with_bsdf: true,
-            ..self
-        }
+    /// The same receiver, for light samples that MIS combines with BSDF samples. The
+    /// flag is set in place: rebuilding the struct made the path loop copy it through
+    /// memory in words wider than its fields were written, which stalls store-to-load
+    /// forwarding.
+    #[inline(always)]
+    pub fn with_mis(mut self) -> LightSampleContext {
+        self.mis_with_bsdf = true;
+        self
     }
 
     /// A receiver on a surface without a separate shading normal (radiosity patches).

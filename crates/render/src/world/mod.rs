@@ -152,9 +152,9 @@ impl World {
     /// The shading normal is that of the hit's material (bump or normal map applied).
     /// Hits that an alpha cut-out lets through are skipped.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
-        let mut hit = self.intersect_shape(ray, t_max)?;
+        let hit = self.intersect_shape(ray, t_max)?;
         if !self.shading_normals.is_empty() {
-            self.perturb_shading_normal(&mut hit, -ray.d.normalize());
+            return Some(self.with_perturbed_normal(hit, -ray.d.normalize()));
         }
         Some(hit)
     }
@@ -172,7 +172,7 @@ impl World {
         let mut hit = self.intersect_shape(ray, t_max)?;
         self.add_footprint(&mut hit, ray.d, travelled);
         if !self.shading_normals.is_empty() {
-            self.perturb_shading_normal(&mut hit, -ray.d.normalize());
+            return Some(self.with_perturbed_normal(hit, -ray.d.normalize()));
         }
         Some(hit)
     }
@@ -189,13 +189,18 @@ impl World {
         Some(hit)
     }
 
-    /// Tilts `hit.ns` by the bump or normal map of the material that shades it seen
-    /// from `wo_world` (for a mix, the chosen material's).
-    fn perturb_shading_normal(&self, hit: &mut SurfaceHit, wo_world: Vec3) {
-        let index = self.resolve_index(hit.material, hit.p, wo_world, Some(hit));
+    /// `hit` with `ns` tilted by the bump or normal map of the material that shades it
+    /// seen from `wo_world` (for a mix, the chosen material's). Taken and returned by
+    /// value: a `&mut` to the caller's hit would keep that hit in memory on every path,
+    /// and reading back its fields as wider words than they were written stalls
+    /// store-to-load forwarding.
+    #[inline(never)]
+    fn with_perturbed_normal(&self, mut hit: SurfaceHit, wo_world: Vec3) -> SurfaceHit {
+        let index = self.resolve_index(hit.material, hit.p, wo_world, Some(&hit));
         if let Some(Some(normal)) = self.shading_normals.get(index as usize) {
-            normals::perturb(hit, normal, &self.textures);
+            normals::perturb(&mut hit, normal, &self.textures);
         }
+        hit
     }
 
     /// True when anything blocks the ray in `(0, t_max)` (alpha cut-outs let it
@@ -412,6 +417,7 @@ impl World {
     /// first axis along ∂p/∂u for anisotropic BSDFs (pbrt's orientation of
     /// `uroughness`). Isotropic BSDFs do not depend on the tangent, and keep the
     /// branch-free frame of the normal alone.
+    #[inline(always)]
     pub fn shading_frame(hit: &SurfaceHit, material: &Material) -> Frame {
         if material.is_anisotropic() {
             Frame::from_normal_tangent(hit.ns, hit.dpdu)

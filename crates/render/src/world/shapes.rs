@@ -473,6 +473,7 @@ impl ShapeSet {
         }
     }
 
+    #[inline(always)]
     fn triangle_hit(&self, t: f32, index: u32, b: [f32; 3]) -> SurfaceHit {
         let [p0, p1, p2] = self.triangles[index as usize];
         let attr = self.triangle_attrs[index as usize];
