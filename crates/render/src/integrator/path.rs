@@ -5,7 +5,7 @@
 use crate::geometry::Ray;
 use crate::light::{Light, LightSampleContext};
 use crate::material::TransportMode;
-use crate::sampler::PixelSample;
+use crate::sampler::{ContinuedPair, PixelSample, SobolAnchor};
 use crate::world::{NO_LIGHT, World};
 use radiant_math::color::Rgb;
 use radiant_math::sampling::power_heuristic;
@@ -157,6 +157,8 @@ pub fn radiance(
     let mut prev_ctx = LightSampleContext::at_point(ray.o);
     let mut rays = 0u32;
     let mut depth = 0u32;
+    // The draw of the first bounce's direction, which the second vertex's draws continue.
+    let mut first_direction: Option<SobolAnchor> = None;
     // Distance along the path from the camera, for texture footprints.
     let mut travelled = 0.0f32;
     loop {
@@ -210,7 +212,15 @@ pub fn radiance(
         // Drawn for every vertex so that the dimension layout does not depend on the material.
         let lit = !material.is_specular();
         let u_choice = sampler.get_1d_if(lit && world.light_sampler.uses_choice_sample());
-        let u_light = sampler.get_2d_if(lit);
+        // The second vertex's light sample and direction continue the Sobol point of the
+        // first direction, so that two-bounce paths, much of a pixel's indirect light,
+        // are stratified jointly rather than pair by pair: cornell-box at 256 spp has a
+        // relMSE of 4.42e-4 instead of 5.04e-4 (docs/speed.md).
+        let continued = if depth == 2 { first_direction } else { None };
+        let u_light = match continued {
+            Some(anchor) => sampler.get_2d_continuing_if(lit, anchor, ContinuedPair::Third),
+            None => sampler.get_2d_if(lit),
+        };
         if lit {
             let at = direct::ShadingPoint::in_frame(&hit, material, frame, wo_world, wo).with_mis();
             let ds = direct::sample_direct(world, scene, &at, u_choice, u_light);
@@ -226,7 +236,15 @@ pub fn radiance(
         }
 
         let u_lobe = sampler.get_1d_if(material.uses_lobe_sample());
-        let u_dir = sampler.get_2d();
+        let u_dir = match continued {
+            Some(anchor) => sampler.get_2d_continuing(anchor, ContinuedPair::Second),
+            None if depth == 1 => {
+                let (u, anchor) = sampler.get_2d_as_anchor();
+                first_direction = Some(anchor);
+                u
+            }
+            None => sampler.get_2d(),
+        };
         let Some(bs) = material.sample(wo, u_lobe, u_dir, TransportMode::Radiance) else {
             break;
         };

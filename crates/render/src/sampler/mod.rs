@@ -21,8 +21,8 @@ use radiant_math::hash::{hash_u64s, mix64, u32_to_unit_f32};
 use radiant_scene::SamplerKind;
 
 pub use halton::{PRIME_COUNT, PRIMES, randomized_radical_inverse};
-use sobol::owen_scramble_reversed;
 pub use sobol::{owen_scramble, scrambled_sobol, sobol_u32};
+use sobol::{owen_scramble_reversed, scrambled_further_sobol};
 pub use stratified::{permute, stratified_1d, stratified_2d};
 
 /// The sampler state for one pixel sample.
@@ -103,9 +103,60 @@ impl PixelSample {
 
     #[inline(always)]
     fn next_key(&mut self) -> u64 {
-        let k = mix64(self.pixel_key ^ (self.dim as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        let k = dimension_key(self.pixel_key, self.dim);
         self.dim += 1;
         k
+    }
+
+    /// [`get_2d`](Self::get_2d), and the draw as an anchor that later draws may continue
+    /// (see [`get_2d_continuing`](Self::get_2d_continuing)).
+    #[inline]
+    pub fn get_2d_as_anchor(&mut self) -> (Vec2, SobolAnchor) {
+        let anchor = SobolAnchor {
+            shuffled_index: self.shuffled_index(dimension_key(self.pixel_key, self.dim)),
+        };
+        (self.get_2d(), anchor)
+    }
+
+    /// A 2D draw that takes further dimensions of the Sobol point an earlier 2D draw,
+    /// `anchor`, took dimensions 0 and 1 of: the same shuffled sample index, Owen-scrambled
+    /// with this draw's own key. Padding pairs independently (as [`get_2d`](Self::get_2d)
+    /// does) stratifies each pair alone; draws that continue one point are stratified
+    /// jointly, a (t, 4)- or (t, 6)-net over a pixel's samples with small t (the tests
+    /// state them). Worth it where the integrand couples the draws strongly, such as the
+    /// directions of a path's first two bounces. Other samplers draw as `get_2d`.
+    #[inline]
+    pub fn get_2d_continuing(&mut self, anchor: SobolAnchor, pair: ContinuedPair) -> Vec2 {
+        if self.kind != SamplerKind::Sobol {
+            return self.get_2d();
+        }
+        let i = anchor.shuffled_index;
+        let h = mix64(self.next_key());
+        let [dx, dy] = match pair {
+            ContinuedPair::Second => sobol::SECOND_PAIR,
+            ContinuedPair::Third => sobol::THIRD_PAIR,
+        };
+        Vec2::new(
+            u32_to_unit_f32(scrambled_further_sobol(dx, i, h as u32)),
+            u32_to_unit_f32(scrambled_further_sobol(dy, i, (h >> 32) as u32)),
+        )
+    }
+
+    /// [`get_2d_continuing`](Self::get_2d_continuing) when `needed`; otherwise (0, 0),
+    /// the dimension consumed either way (as [`get_2d_if`](Self::get_2d_if)).
+    #[inline]
+    pub fn get_2d_continuing_if(
+        &mut self,
+        needed: bool,
+        anchor: SobolAnchor,
+        pair: ContinuedPair,
+    ) -> Vec2 {
+        if needed {
+            self.get_2d_continuing(anchor, pair)
+        } else {
+            self.dim += 1;
+            Vec2::ZERO
+        }
     }
 
     /// One uniform number in [0, 1).
@@ -214,6 +265,28 @@ impl PixelSample {
     }
 }
 
+/// A 2D draw whose Sobol point later draws continue: the sample index as that draw
+/// shuffled it (meaningless for samplers other than Sobol, which ignore it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SobolAnchor {
+    shuffled_index: u32,
+}
+
+/// Which further dimensions of an anchor's Sobol point a continuing draw takes:
+/// `Second` dimensions 2 and 3, `Third` dimensions 4 and 5.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContinuedPair {
+    Second,
+    Third,
+}
+
+/// The key of dimension `dim` of the pixel (or stream) `pixel_key`: what shuffles and
+/// scrambles that dimension's points, the same for all of the pixel's samples.
+#[inline(always)]
+fn dimension_key(pixel_key: u64, dim: u32) -> u64 {
+    mix64(pixel_key ^ (dim as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15))
+}
+
 fn independent(key: u64, index: u32) -> f32 {
     u32_to_unit_f32(mix64(key ^ index as u64) as u32)
 }
@@ -287,6 +360,114 @@ mod tests {
             assert_eq!(drawn.get_1d_if(true), skipped.get_1d(), "{kind:?}");
             assert_eq!(drawn.get_2d_if(true), skipped.get_2d(), "{kind:?}");
         }
+    }
+
+    /// The t of a (t, m, s)-net of 2^m points in [0, 1)^s: the smallest t for which every
+    /// elementary box of volume 2^(t−m) holds exactly 2^t points (Niederreiter 1992).
+    fn t_value(points: &[Vec<f32>]) -> u32 {
+        let m = points.len().trailing_zeros();
+        let s = points[0].len();
+        // Every split of `bits` binary digits among the s coordinates.
+        fn splits(bits: u32, s: usize) -> Vec<Vec<u32>> {
+            if s == 1 {
+                return vec![vec![bits]];
+            }
+            (0..=bits)
+                .flat_map(|first| {
+                    splits(bits - first, s - 1)
+                        .into_iter()
+                        .map(move |mut rest| {
+                            rest.insert(0, first);
+                            rest
+                        })
+                })
+                .collect()
+        }
+        (0..=m)
+            .find(|&t| {
+                splits(m - t, s).iter().all(|digits| {
+                    let mut count = std::collections::HashMap::new();
+                    for p in points {
+                        let cell: Vec<u32> = p
+                            .iter()
+                            .zip(digits)
+                            .map(|(&x, &d)| (x * (1u64 << d) as f32) as u32)
+                            .collect();
+                        *count.entry(cell).or_insert(0u32) += 1;
+                    }
+                    count.values().all(|&c| c == 1 << t)
+                })
+            })
+            .expect("t = m always holds")
+    }
+
+    /// The second vertex's draws of a path continue the first direction's point: over
+    /// 2^m samples of a pixel the anchor and its continuations form nets of small t
+    /// (those of the unscrambled Sobol dimensions 0–5, which Owen scrambling keeps).
+    /// Padded pairs, each shuffled on its own, are hardly a net in 4D (t near m).
+    #[test]
+    fn continued_draws_are_stratified_jointly_with_their_anchor() {
+        for &(seed, x, y) in &[(1u64, 0u32, 0u32), (7, 17, 3), (3, 255, 128)] {
+            for m in [4u32, 6, 8] {
+                let mut anchor_pair = Vec::new();
+                let mut second = Vec::new();
+                let mut third = Vec::new();
+                let mut padded = Vec::new();
+                for i in 0..1u32 << m {
+                    let mut s = PixelSample::new(SamplerKind::Sobol, seed, x, y, i);
+                    s.get_2d();
+                    let (a, anchor) = s.get_2d_as_anchor();
+                    s.get_1d();
+                    let c3 = s.get_2d_continuing(anchor, ContinuedPair::Third);
+                    let c2 = s.get_2d_continuing(anchor, ContinuedPair::Second);
+                    let p = s.get_2d();
+                    anchor_pair.push(a);
+                    second.push(c2);
+                    third.push(c3);
+                    padded.push(p);
+                }
+                let joint = |parts: &[&[Vec2]]| -> Vec<Vec<f32>> {
+                    (0..anchor_pair.len())
+                        .map(|i| parts.iter().flat_map(|q| [q[i].x, q[i].y]).collect())
+                        .collect()
+                };
+                let ctx = format!("seed {seed} pixel ({x}, {y}), 2^{m} samples");
+                assert_eq!(t_value(&joint(&[&anchor_pair])), 0, "{ctx}");
+                assert!(t_value(&joint(&[&second])) <= 1, "{ctx}");
+                assert!(t_value(&joint(&[&third])) <= 3, "{ctx}");
+                assert!(t_value(&joint(&[&anchor_pair, &second])) <= 3, "{ctx}");
+                assert!(
+                    t_value(&joint(&[&anchor_pair, &second, &third])) <= 4,
+                    "{ctx}"
+                );
+                if m >= 6 {
+                    assert!(t_value(&joint(&[&anchor_pair, &padded])) >= m - 2, "{ctx}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn continued_draws_consume_their_dimension_and_other_samplers_draw_plainly() {
+        let mut plain = PixelSample::new(SamplerKind::Independent, 3, 4, 5, 6);
+        let mut continued = plain.clone();
+        let (a, anchor) = continued.get_2d_as_anchor();
+        assert_eq!(a, plain.get_2d());
+        assert_eq!(
+            continued.get_2d_continuing(anchor, ContinuedPair::Second),
+            plain.get_2d()
+        );
+        let mut sobol = PixelSample::new(SamplerKind::Sobol, 3, 4, 5, 6);
+        let mut skipped = sobol.clone();
+        let (a, anchor) = sobol.get_2d_as_anchor();
+        assert_eq!(a, skipped.get_2d());
+        let c = sobol.get_2d_continuing_if(true, anchor, ContinuedPair::Third);
+        assert!((0.0..1.0).contains(&c.x) && (0.0..1.0).contains(&c.y));
+        assert_eq!(
+            skipped.get_2d_continuing_if(false, anchor, ContinuedPair::Third),
+            Vec2::ZERO
+        );
+        assert_eq!(sobol.get_2d(), skipped.get_2d());
     }
 
     #[test]

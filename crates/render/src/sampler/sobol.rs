@@ -1,4 +1,5 @@
-//! The first two Sobol dimensions and hash-based Owen scrambling.
+//! Sobol dimensions (the first two, and four more for draws that continue a point) and
+//! hash-based Owen scrambling.
 
 /// Sobol point `index` in dimension 0 (van der Corput, base 2) or 1, as a 32-bit
 /// fixed-point fraction. Dimension 1 uses the primitive polynomial x + 1, whose
@@ -18,17 +19,60 @@ pub fn sobol_u32(dim: u32, index: u32) -> u32 {
 
 /// Dimension 1 is linear over GF(2) in the index bits, so the image of each index byte
 /// can be tabulated: four lookups and three XORs per point.
-static SOBOL1_BYTES: [[u32; 256]; 4] = sobol1_byte_tables();
+static SOBOL1_BYTES: [[u32; 256]; 4] = byte_tables(direction_numbers(1, 0, [1, 0, 0, 0]), false);
 
-const fn sobol1_byte_tables() -> [[u32; 256]; 4] {
-    let mut directions = [0u32; 32];
-    let mut v = 1u32 << 31;
+/// The further Sobol dimensions radiant uses: (degree s, coefficients a, initial
+/// direction numbers m₁..m_s) of dimensions 2 to 5, with the primitive polynomials
+/// x² + x + 1, x³ + x + 1, x³ + x² + 1 and x⁴ + x + 1 and the initial numbers of Joe &
+/// Kuo, "Constructing Sobol sequences with better two-dimensional projections" (SIAM J.
+/// Sci. Comput. 2008).
+const FURTHER_DIMENSIONS: [(usize, u32, [u32; 4]); 4] = [
+    (2, 1, [1, 3, 0, 0]),
+    (3, 1, [1, 3, 1, 0]),
+    (3, 2, [1, 1, 1, 0]),
+    (4, 1, [1, 1, 3, 3]),
+];
+
+/// Which of [`FURTHER_DIMENSIONS`] a continued pair takes (see [`ContinuedPair`](super::ContinuedPair)).
+pub(super) const SECOND_PAIR: [usize; 2] = [0, 1];
+pub(super) const THIRD_PAIR: [usize; 2] = [2, 3];
+
+/// The 32 direction numbers v_k = m_k / 2^k (as 32-bit fractions) of a dimension with
+/// primitive polynomial x^s + a₁x^{s−1} + … + a_{s−1}x + 1 (a = a₁…a_{s−1} in binary),
+/// by Sobol's recurrence m_k = 2a₁m_{k−1} ⊕ … ⊕ 2^{s−1}a_{s−1}m_{k−s+1} ⊕ 2^s m_{k−s} ⊕ m_{k−s}
+/// (Bratley & Fox, "Algorithm 659", ACM TOMS 1988).
+const fn direction_numbers(s: usize, a: u32, initial: [u32; 4]) -> [u32; 32] {
+    let mut m = [0u32; 32];
     let mut k = 0;
     while k < 32 {
-        directions[k] = v;
-        v ^= v >> 1;
+        m[k] = if k < s {
+            initial[k]
+        } else {
+            let mut v = m[k - s] ^ (m[k - s] << s);
+            let mut j = 1;
+            while j < s {
+                if (a >> (s - 1 - j)) & 1 == 1 {
+                    v ^= m[k - j] << j;
+                }
+                j += 1;
+            }
+            v
+        };
         k += 1;
     }
+    let mut v = [0u32; 32];
+    let mut k = 0;
+    while k < 32 {
+        v[k] = m[k] << (31 - k);
+        k += 1;
+    }
+    v
+}
+
+/// The image of each index byte under a dimension's direction numbers (the point is
+/// linear over GF(2) in the index bits), bit-reversed where `reversed` for scrambling in
+/// the reversed domain.
+const fn byte_tables(directions: [u32; 32], reversed: bool) -> [[u32; 256]; 4] {
     let mut tables = [[0u32; 256]; 4];
     let mut byte = 0;
     while byte < 4 {
@@ -42,12 +86,56 @@ const fn sobol1_byte_tables() -> [[u32; 256]; 4] {
                 }
                 bit += 1;
             }
-            tables[byte][value] = acc;
+            tables[byte][value] = if reversed { acc.reverse_bits() } else { acc };
             value += 1;
         }
         byte += 1;
     }
     tables
+}
+
+/// The image of each 4-bit digit of the index, per further dimension, bit-reversed for
+/// scrambling in the reversed domain. Nibbles, not bytes: a shuffled sample index has
+/// random high bits, so every table entry is as likely as any other, and byte tables
+/// (16 KiB for the four dimensions) fell out of the L1 cache where these (2 KiB) stay.
+static FURTHER_NIBBLES_REVERSED: [[[u32; 16]; 8]; 4] = {
+    let mut t = [[[0u32; 16]; 8]; 4];
+    let mut d = 0;
+    while d < 4 {
+        let (s, a, m) = FURTHER_DIMENSIONS[d];
+        let v = direction_numbers(s, a, m);
+        let mut nibble = 0;
+        while nibble < 8 {
+            let mut value = 0;
+            while value < 16 {
+                let mut acc = 0u32;
+                let mut bit = 0;
+                while bit < 4 {
+                    if value & (1 << bit) != 0 {
+                        acc ^= v[nibble * 4 + bit];
+                    }
+                    bit += 1;
+                }
+                t[d][nibble][value] = acc.reverse_bits();
+                value += 1;
+            }
+            nibble += 1;
+        }
+        d += 1;
+    }
+    t
+};
+
+/// Owen-scrambled Sobol point `index` of further dimension `further` (an index into
+/// [`FURTHER_DIMENSIONS`]), scrambled in the reversed domain as [`scrambled_sobol`].
+#[inline]
+pub fn scrambled_further_sobol(further: usize, index: u32, seed: u32) -> u32 {
+    let t = &FURTHER_NIBBLES_REVERSED[further];
+    let mut reversed = 0;
+    for (nibble, table) in t.iter().enumerate() {
+        reversed ^= table[((index >> (4 * nibble)) & 15) as usize];
+    }
+    laine_karras(reversed, seed).reverse_bits()
 }
 
 /// Owen-scrambled Sobol point `index` of dimension `dim` (0 or 1). The scramble works
@@ -69,19 +157,8 @@ pub fn scrambled_sobol(dim: u32, index: u32, seed: u32) -> u32 {
     laine_karras(reversed, seed).reverse_bits()
 }
 
-static SOBOL1_BYTES_REVERSED: [[u32; 256]; 4] = {
-    let mut t = sobol1_byte_tables();
-    let mut byte = 0;
-    while byte < 4 {
-        let mut v = 0;
-        while v < 256 {
-            t[byte][v] = t[byte][v].reverse_bits();
-            v += 1;
-        }
-        byte += 1;
-    }
-    t
-};
+static SOBOL1_BYTES_REVERSED: [[u32; 256]; 4] =
+    byte_tables(direction_numbers(1, 0, [1, 0, 0, 0]), true);
 
 /// The Laine–Karras style hash: each output bit depends only on itself and lower bits.
 #[inline]
@@ -147,6 +224,33 @@ mod tests {
                         scrambled_sobol(dim, i, seed),
                         owen_scramble(sobol_u32(dim, i), seed)
                     );
+                }
+            }
+        }
+    }
+
+    /// The tabulated further dimensions against the direction numbers applied bit by bit,
+    /// and each a (0, 1)-sequence: 2^k consecutive points fill the 2^k intervals of
+    /// length 2^−k once each (which valid initial numbers m_k, odd and below 2^k, ensure).
+    #[test]
+    fn further_dimensions_match_their_direction_numbers_and_stratify() {
+        for (further, &(s, a, m)) in FURTHER_DIMENSIONS.iter().enumerate() {
+            let v = direction_numbers(s, a, m);
+            for i in [0u32, 1, 2, 3, 77, 255, 256, 65_535, 0x8000_0001, u32::MAX] {
+                let direct = (0..32)
+                    .filter(|k| i & (1 << k) != 0)
+                    .fold(0u32, |x, k| x ^ v[k]);
+                assert_eq!(
+                    scrambled_further_sobol(further, i, 0x1234_5678),
+                    owen_scramble(direct, 0x1234_5678),
+                    "dimension {further} index {i}"
+                );
+            }
+            for k in [1u32, 4, 8] {
+                let mut seen = vec![false; 1 << k];
+                for i in 0..1u32 << k {
+                    let x = scrambled_further_sobol(further, i, 0) >> (32 - k);
+                    assert!(!std::mem::replace(&mut seen[x as usize], true));
                 }
             }
         }

@@ -547,6 +547,7 @@ pub(super) fn triangle_uvs(
 /// ∂p/∂u and ∂p/∂v of a triangle from its vertex uvs (the inverse of the 2×2 uv Jacobian, as in
 /// pbrt-v4's triangle); zero when the uvs are degenerate, so that the shading frame
 /// falls back to an arbitrary tangent.
+#[inline(always)]
 fn triangle_tangents(p: [Vec3; 3], uv: [Vec2; 3]) -> (Vec3, Vec3) {
     let (duv02, duv12) = (uv[0] - uv[2], uv[1] - uv[2]);
     let (dp02, dp12) = (p[0] - p[2], p[1] - p[2]);
