@@ -6,6 +6,9 @@
 //! The Sobol sampler pads 2D Sobol points across dimension pairs with hash-based Owen
 //! scrambling and index shuffling (Burley, "Practical Hash-based Owen Scrambling",
 //! JCGT 2020), which keeps every pair well stratified and decorrelates the pairs.
+//! Where an integrand couples draws strongly, a draw may instead continue an earlier
+//! draw's Sobol point (`get_2d_as_anchor`, `get_2d_continuing`): the draws then form one
+//! low-discrepancy net over the pixel's samples rather than independent pairs.
 //! Halton points use the primes of their dimension pair as bases (halton.rs), and
 //! the stratified sampler jitters within a per-pixel random order of strata
 //! (stratified.rs). Streams not tied to a pixel (photons) have no strata count, so a
