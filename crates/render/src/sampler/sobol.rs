@@ -7,19 +7,16 @@
 pub fn sobol_u32(dim: u32, index: u32) -> u32 {
     match dim {
         0 => index.reverse_bits(),
-        _ => {
-            let b = index.to_le_bytes();
-            SOBOL1_BYTES[0][b[0] as usize]
-                ^ SOBOL1_BYTES[1][b[1] as usize]
-                ^ SOBOL1_BYTES[2][b[2] as usize]
-                ^ SOBOL1_BYTES[3][b[3] as usize]
-        }
+        _ => digit_image(&SOBOL1_BYTES, index),
     }
 }
 
 /// Dimension 1 is linear over GF(2) in the index bits, so the image of each index byte
 /// can be tabulated: four lookups and three XORs per point.
-static SOBOL1_BYTES: [[u32; 256]; 4] = byte_tables(direction_numbers(1, 0, [1, 0, 0, 0]), false);
+static SOBOL1_BYTES: [[u32; 256]; 4] = digit_tables(SOBOL1_DIRECTIONS, false);
+
+/// Dimension 1: the polynomial x + 1, m₁ = 1.
+const SOBOL1_DIRECTIONS: [u32; 32] = direction_numbers(1, 0, [1, 0, 0, 0]);
 
 /// The further Sobol dimensions radiant uses: (degree s, coefficients a, initial
 /// direction numbers m₁..m_s) of dimensions 2 to 5, with the primitive polynomials
@@ -69,29 +66,48 @@ const fn direction_numbers(s: usize, a: u32, initial: [u32; 4]) -> [u32; 32] {
     v
 }
 
-/// The image of each index byte under a dimension's direction numbers (the point is
-/// linear over GF(2) in the index bits), bit-reversed where `reversed` for scrambling in
-/// the reversed domain.
-const fn byte_tables(directions: [u32; 32], reversed: bool) -> [[u32; 256]; 4] {
-    let mut tables = [[0u32; 256]; 4];
-    let mut byte = 0;
-    while byte < 4 {
+/// The image of each `32 / DIGITS`-bit digit of the index under a dimension's direction
+/// numbers (a Sobol point is linear over GF(2) in the index bits, so it is the XOR of its
+/// digits' images), bit-reversed where `reversed` for scrambling in the reversed domain.
+/// `ENTRIES` is 2 to the digit's bits: bytes (256, 4) or nibbles (16, 8).
+const fn digit_tables<const ENTRIES: usize, const DIGITS: usize>(
+    directions: [u32; 32],
+    reversed: bool,
+) -> [[u32; ENTRIES]; DIGITS] {
+    let bits = 32 / DIGITS;
+    let mut tables = [[0u32; ENTRIES]; DIGITS];
+    let mut digit = 0;
+    while digit < DIGITS {
         let mut value = 0;
-        while value < 256 {
+        while value < ENTRIES {
             let mut acc = 0u32;
             let mut bit = 0;
-            while bit < 8 {
+            while bit < bits {
                 if value & (1 << bit) != 0 {
-                    acc ^= directions[byte * 8 + bit];
+                    acc ^= directions[digit * bits + bit];
                 }
                 bit += 1;
             }
-            tables[byte][value] = if reversed { acc.reverse_bits() } else { acc };
+            tables[digit][value] = if reversed { acc.reverse_bits() } else { acc };
             value += 1;
         }
-        byte += 1;
+        digit += 1;
     }
     tables
+}
+
+/// The point of `index` from a dimension's [`digit_tables`]: its digits' images XORed.
+#[inline(always)]
+fn digit_image<const ENTRIES: usize, const DIGITS: usize>(
+    tables: &[[u32; ENTRIES]; DIGITS],
+    index: u32,
+) -> u32 {
+    let bits = 32 / DIGITS;
+    let mut x = 0;
+    for (digit, table) in tables.iter().enumerate() {
+        x ^= table[(index >> (bits * digit)) as usize & (ENTRIES - 1)];
+    }
+    x
 }
 
 /// The image of each 4-bit digit of the index, per further dimension, bit-reversed for
@@ -103,24 +119,7 @@ static FURTHER_NIBBLES_REVERSED: [[[u32; 16]; 8]; 4] = {
     let mut d = 0;
     while d < 4 {
         let (s, a, m) = FURTHER_DIMENSIONS[d];
-        let v = direction_numbers(s, a, m);
-        let mut nibble = 0;
-        while nibble < 8 {
-            let mut value = 0;
-            while value < 16 {
-                let mut acc = 0u32;
-                let mut bit = 0;
-                while bit < 4 {
-                    if value & (1 << bit) != 0 {
-                        acc ^= v[nibble * 4 + bit];
-                    }
-                    bit += 1;
-                }
-                t[d][nibble][value] = acc.reverse_bits();
-                value += 1;
-            }
-            nibble += 1;
-        }
+        t[d] = digit_tables(direction_numbers(s, a, m), true);
         d += 1;
     }
     t
@@ -130,11 +129,7 @@ static FURTHER_NIBBLES_REVERSED: [[[u32; 16]; 8]; 4] = {
 /// [`FURTHER_DIMENSIONS`]), scrambled in the reversed domain as [`scrambled_sobol`].
 #[inline]
 pub fn scrambled_further_sobol(further: usize, index: u32, seed: u32) -> u32 {
-    let t = &FURTHER_NIBBLES_REVERSED[further];
-    let mut reversed = 0;
-    for (nibble, table) in t.iter().enumerate() {
-        reversed ^= table[((index >> (4 * nibble)) & 15) as usize];
-    }
+    let reversed = digit_image(&FURTHER_NIBBLES_REVERSED[further], index);
     laine_karras(reversed, seed).reverse_bits()
 }
 
@@ -146,19 +141,12 @@ pub fn scrambled_further_sobol(further: usize, index: u32, seed: u32) -> u32 {
 pub fn scrambled_sobol(dim: u32, index: u32, seed: u32) -> u32 {
     let reversed = match dim {
         0 => index,
-        _ => {
-            let b = index.to_le_bytes();
-            SOBOL1_BYTES_REVERSED[0][b[0] as usize]
-                ^ SOBOL1_BYTES_REVERSED[1][b[1] as usize]
-                ^ SOBOL1_BYTES_REVERSED[2][b[2] as usize]
-                ^ SOBOL1_BYTES_REVERSED[3][b[3] as usize]
-        }
+        _ => digit_image(&SOBOL1_BYTES_REVERSED, index),
     };
     laine_karras(reversed, seed).reverse_bits()
 }
 
-static SOBOL1_BYTES_REVERSED: [[u32; 256]; 4] =
-    byte_tables(direction_numbers(1, 0, [1, 0, 0, 0]), true);
+static SOBOL1_BYTES_REVERSED: [[u32; 256]; 4] = digit_tables(SOBOL1_DIRECTIONS, true);
 
 /// The Laine–Karras style hash: each output bit depends only on itself and lower bits.
 #[inline]
