@@ -96,12 +96,7 @@ impl PixelSample {
     /// The Sobol pair of dimension key `key`: dimensions 0 and 1 of the shuffled index.
     #[inline(always)]
     fn sobol_2d(&self, key: u64) -> Vec2 {
-        let i = self.shuffled_index(key);
-        let h = mix64(key);
-        Vec2::new(
-            u32_to_unit_f32(scrambled_sobol(0, i, h as u32)),
-            u32_to_unit_f32(scrambled_sobol(1, i, (h >> 32) as u32)),
-        )
+        sobol_2d_at(self.shuffled_index(key), key)
     }
 
     #[inline(always)]
@@ -115,10 +110,12 @@ impl PixelSample {
     /// (see [`get_2d_continuing`](Self::get_2d_continuing)).
     #[inline]
     pub fn get_2d_as_anchor(&mut self) -> (Vec2, SobolAnchor) {
-        let anchor = SobolAnchor {
-            shuffled_index: self.shuffled_index(dimension_key(self.pixel_key, self.dim)),
-        };
-        (self.get_2d(), anchor)
+        if self.kind != SamplerKind::Sobol {
+            return (self.get_2d(), SobolAnchor { shuffled_index: 0 });
+        }
+        let key = self.next_key();
+        let i = self.shuffled_index(key);
+        (sobol_2d_at(i, key), SobolAnchor { shuffled_index: i })
     }
 
     /// A 2D draw that takes further dimensions of the Sobol point an earlier 2D draw,
@@ -281,6 +278,17 @@ pub struct SobolAnchor {
 pub enum ContinuedPair {
     Second,
     Third,
+}
+
+/// The Sobol pair of dimension key `key` at shuffled index `i`: dimensions 0 and 1,
+/// Owen-scrambled with a hash of the key.
+#[inline(always)]
+fn sobol_2d_at(i: u32, key: u64) -> Vec2 {
+    let h = mix64(key);
+    Vec2::new(
+        u32_to_unit_f32(scrambled_sobol(0, i, h as u32)),
+        u32_to_unit_f32(scrambled_sobol(1, i, (h >> 32) as u32)),
+    )
 }
 
 /// The key of dimension `dim` of the pixel (or stream) `pixel_key`: what shuffles and
