@@ -434,10 +434,11 @@ impl World {
     }
 
     /// Sets the hit's footprint for a ray of direction `d` that had travelled
-    /// `travelled` from the camera before it started (only when textures or bump maps
-    /// need it, so the distance to the hit is only measured then).
+    /// `travelled` from the camera before it started. Called only where textures or
+    /// bump maps use footprints (`footprints_used`), so the distance to the hit is only
+    /// measured then.
     fn add_footprint(&self, hit: &mut SurfaceHit, d: Vec3, travelled: f32) {
-        if self.footprints_used && self.ray_spread != RaySpread::NONE {
+        if self.ray_spread != RaySpread::NONE {
             let distance = travelled + hit.t * d.length();
             (hit.dpdx, hit.dpdy) = self.ray_spread.differentials(d, distance, hit.ng);
         }
