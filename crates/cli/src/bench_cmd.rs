@@ -123,6 +123,9 @@ struct Task {
     target: f64,
     /// Samples per pixel (SPPM: iterations) of the convergence run.
     max_spp: u32,
+    /// Adaptive sampling: the run's last snapshot is its whole budget (`max_spp` on
+    /// average), the earlier ones its uniform pilot.
+    adaptive: bool,
 }
 
 impl Task {
@@ -145,7 +148,8 @@ fn convergence(task: &Task, reference: &Image, seed: u64) -> anyhow::Result<Vec<
         integrator: Some(task.integrator.to_string()),
         ..Default::default()
     };
-    let session = radiant::Session::new(&(task.scene)(), &overrides)?;
+    let mut session = radiant::Session::new(&(task.scene)(), &overrides)?;
+    session.ctx.adaptive = task.adaptive;
     let mut snapshots: Vec<(u32, f64, Image)> = Vec::new();
     session.render_with_snapshots(&Progress::default(), &mut |n, film| {
         let t = cpu_seconds() - start;
@@ -205,6 +209,17 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
             crop: None,
             target: 6e-4,
             max_spp: 512,
+            adaptive: false,
+        },
+        Task {
+            label: "cornell-box, path, adaptive (256 spp on average), to relMSE 6e-4",
+            scene: cornell_box,
+            integrator: "path",
+            reference: "cornell-box-256-ref.exr",
+            crop: None,
+            target: 6e-4,
+            max_spp: 256,
+            adaptive: true,
         },
         Task {
             label: "cornell-caustics caustic crop (x 160..192, y 232..244), sppm, to 4e-3",
@@ -214,6 +229,7 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
             crop: Some(caustic_crop),
             target: 4e-3,
             max_spp: 128,
+            adaptive: false,
         },
         Task {
             label: "cornell-caustics whole image, sppm, to 7.5e-4",
@@ -223,6 +239,7 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
             crop: None,
             target: 7.5e-4,
             max_spp: 128,
+            adaptive: false,
         },
     ];
     out!(

@@ -10,7 +10,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 use radiant::checkpoint::{self, RunKey};
 use radiant::image::{ImageMeta, write_image};
-use radiant::render::integrator::{CheckpointHook, IntegratorState};
+use radiant::render::integrator::{CheckpointHook, IntegratorState, StateKind};
 use radiant::render::{Overrides, Progress};
 
 use crate::pbrt_opts::{AOV_SAMPLES, LogLevel, MemoryUse, PassWatchers, PbrtArgs, PhaseTimes};
@@ -48,6 +48,12 @@ pub struct RenderArgs {
     /// power of two, as NAME-00016.EXT beside the output.
     #[arg(long)]
     pub snapshots: bool,
+    /// Adaptive sampling: --spp becomes the mean samples per pixel; a uniform pilot of a
+    /// quarter of them estimates each pixel's relative variance, and the rest go where
+    /// it is highest (in proportion to its square root, 5x5-smoothed). Path tracer,
+    /// photon map and radiosity display; not with checkpoints or units.
+    #[arg(long)]
+    pub adaptive: bool,
     /// Image size as WIDTHxHEIGHT, overriding the film's.
     #[arg(long, value_parser = parse_resolution)]
     pub resolution: Option<(u32, u32)>,
@@ -277,6 +283,23 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let mut session = Session::new(&desc, &overrides)?;
     session.ctx.moments = variance;
     times.build = phase.elapsed().as_secs_f64();
+    if args.adaptive {
+        // The adaptive phase needs the pilot's second moments, which checkpoints do not
+        // keep, and its counts come from the whole image, which a unit does not see.
+        if session.integrator.state_kind() != StateKind::Film {
+            bail!(
+                "--adaptive: the {} integrator does not take its samples pixel by pixel",
+                session.integrator.name()
+            );
+        }
+        if args.checkpoint.target().is_some() {
+            bail!("--adaptive does not combine with --checkpoint or --resume");
+        }
+        if args.unit.any() {
+            bail!("--adaptive renders whole images, not a unit of one");
+        }
+        session.ctx.adaptive = true;
+    }
     if warn {
         for w in &session.warnings {
             eprintln!("{w}");
@@ -503,12 +526,23 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         for line in stats.lines() {
             eprintln!("{line}");
         }
+        let spp = if session.ctx.adaptive {
+            let film = &output_data.film;
+            let most = film.pixels.iter().map(|p| p.samples).max().unwrap_or(0);
+            let taken: u64 = film.pixels.iter().map(|p| p.samples as u64).sum();
+            let mean = taken as f64 / film.pixels.len().max(1) as f64;
+            format!(
+                "{mean:.1} spp adaptive ({}-{most} per pixel)",
+                output_data.spp_done
+            )
+        } else {
+            format!("{} spp", output_data.spp_done)
+        };
         eprintln!(
-            "{}: {}x{}, {} spp, {} integrator, {:.2} s, {:.2} Mrays/s",
+            "{}: {}x{}, {spp}, {} integrator, {:.2} s, {:.2} Mrays/s",
             output.display(),
             session.ctx.resolution.0,
             session.ctx.resolution.1,
-            output_data.spp_done,
             session.integrator.name(),
             output_data.seconds,
             output_data.rays as f64 / output_data.seconds.max(1e-9) / 1e6

@@ -219,3 +219,50 @@ fn radiosity_writes_the_progressive_sequence() {
     let stderr = assert_clean_failure(&out, "--every without --sequence");
     assert!(stderr.contains("--sequence"), "{stderr}");
 }
+
+/// `--adaptive` renders and says how it spread the samples; where it cannot work (SPPM's
+/// iterations, checkpoints that keep no moments, units of a distributed render) it is
+/// refused before any work, with a reason.
+#[test]
+fn adaptive_sampling_renders_and_is_refused_where_it_cannot_work() {
+    let dir = temp_dir("adaptive");
+    let path = dir.join("cb.exr");
+    let out = run(radiant()
+        .args([
+            "render",
+            "--spp",
+            "64",
+            "--resolution",
+            "32x24",
+            "--adaptive",
+            "-o",
+        ])
+        .arg(&path));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("spp adaptive (16-"), "{stderr}");
+    assert!(read_image(&path).unwrap().mean() > 0.0);
+
+    let refused: [&[&str]; 3] = [
+        &["--integrator", "sppm"],
+        &["--checkpoint", "ck.bin"],
+        &["--part", "1/2"],
+    ];
+    for extra in refused {
+        let out = run(radiant()
+            .current_dir(&dir)
+            .args([
+                "render",
+                "--spp",
+                "64",
+                "--resolution",
+                "32x24",
+                "--adaptive",
+            ])
+            .args(extra)
+            .args(["--quiet", "-o", "refused.exr"]));
+        let stderr = assert_clean_failure(&out, &format!("--adaptive {extra:?}"));
+        assert!(stderr.contains("adaptive"), "{extra:?}: {stderr}");
+        assert!(!dir.join("refused.exr").exists(), "{extra:?}");
+    }
+}

@@ -142,6 +142,9 @@ pub struct RenderContext {
     pub work: WorkUnit,
     /// Films keep second moments for a variance channel (pass-loop integrators).
     pub moments: bool,
+    /// Pass-loop integrators spread `spp` samples per pixel on average by the error a
+    /// uniform pilot sees ([`crate::integrator::adaptive`]) instead of evenly.
+    pub adaptive: bool,
 }
 
 /// One pixel sample's camera ray.
@@ -219,6 +222,7 @@ impl RenderContext {
             spp,
             work: WorkUnit::full(resolution, spp),
             moments: false,
+            adaptive: false,
         };
         Ok((context, warnings))
     }

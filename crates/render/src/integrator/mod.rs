@@ -8,6 +8,7 @@
 //! by one pass loop ([`passes`]); SPPM runs its own iterations and writes its
 //! estimates into the film.
 
+pub mod adaptive;
 pub mod direct;
 pub mod footprint;
 pub mod passes;

@@ -2,14 +2,16 @@
 //! … up to 64 samples per pixel), rows in parallel, every sample a pure function of
 //! (pixel, sample index, seed). Between rows the loop checks for cancellation, so an
 //! interrupted render still has a consistent image: every pixel is the mean of the
-//! samples it received, and the film says how many.
+//! samples it received, and the film says how many. An adaptive render
+//! ([`super::adaptive`]) runs the loop up to its pilot, then gives each pixel its own
+//! count.
 
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::{IntegratorState, RenderControl, RenderOutput, Stats};
+use super::{IntegratorState, RenderControl, RenderOutput, Stats, adaptive};
 use crate::context::{Progress, RenderContext, SAMPLE_BLOCK};
 use crate::geometry::Ray;
 use crate::sampler::PixelSample;
@@ -74,6 +76,21 @@ pub fn render_passes<E: PixelEstimator>(
     progress.total.store(w * h * end as u64, Ordering::Relaxed);
     let taken: u64 = film.pixels.iter().map(|p| p.samples.min(end) as u64).sum();
     progress.done.fetch_add(taken, Ordering::Relaxed);
+    // An adaptive render is uniform up to its pilot, then spends the rest of the budget
+    // where the pilot saw the most error. Its film needs second moments, which a resumed
+    // film (checkpoints keep none) lacks: that one is finished uniformly.
+    let adaptive = ctx.adaptive && (film.moments.is_some() || film.min_samples() == 0);
+    if adaptive && film.moments.is_none() {
+        film = film.with_moments();
+    }
+    let budget = end;
+    let end = if adaptive {
+        adaptive::pilot_samples(budget)
+    } else {
+        budget
+    };
+    // The pilot's rays per pixel: the cost side of the allocation.
+    let mut pilot_rays = adaptive.then(|| vec![0u32; film.pixels.len()]);
     let mut spp_done = film.min_samples();
     // The pass schedule of a fresh render (1, 1, 2, 4, … 64, 64, …), picked up where a
     // resumed film left off; the image does not depend on it, the snapshots do.
@@ -87,7 +104,13 @@ pub fn render_passes<E: PixelEstimator>(
         if spp_done > 0 && !spp_done.is_power_of_two() {
             n = n.min(spp_done.next_power_of_two() - spp_done);
         }
-        let nonfinite = render_pass(ctx, estimator, &mut film, spp_done, n, progress);
+        let range = SampleRange {
+            first: spp_done,
+            last: spp_done + n,
+            targets: None,
+        };
+        let rays = pilot_rays.as_deref_mut();
+        let nonfinite = render_range(ctx, estimator, &mut film, range, rays, progress);
         film.nonfinite.merge(nonfinite);
         if progress.cancelled() {
             break;
@@ -102,6 +125,11 @@ pub fn render_passes<E: PixelEstimator>(
             pass = (pass * 2).min(SAMPLE_BLOCK);
         }
     }
+    if adaptive && end < budget && !progress.cancelled() {
+        let rays = pilot_rays.as_deref().unwrap_or(&[]);
+        let nonfinite = render_adaptive(ctx, estimator, control, &mut film, rays, budget);
+        film.nonfinite.merge(nonfinite);
+    }
     let interrupted = progress.cancelled();
     RenderOutput {
         spp_done: film.min_samples(),
@@ -113,6 +141,49 @@ pub fn render_passes<E: PixelEstimator>(
         stats: Stats::default(),
         blocks: Vec::new(),
     }
+}
+
+/// The adaptive phase after the pilot in `film`, which traced `pilot_rays` in each
+/// pixel: each pixel's target from [`adaptive::sample_targets`], reached in rounds that
+/// double the samples a pixel may have (2 × pilot, 4 × pilot, …), so that an
+/// interrupted render has spread its work over the image. The pass watcher sees the film after each round with the
+/// mean samples per pixel so far; the last round is a snapshot of `budget` samples per
+/// pixel on average when `budget` is a power of two.
+fn render_adaptive<E: PixelEstimator>(
+    ctx: &RenderContext,
+    estimator: &E,
+    control: &mut RenderControl<'_>,
+    film: &mut Film,
+    pilot_rays: &[u32],
+    budget: u32,
+) -> NonFinite {
+    let progress = control.progress;
+    let pilot = film.min_samples();
+    let targets = adaptive::sample_targets(film, pilot_rays, budget, pilot);
+    let total: u64 = targets.iter().map(|&t| t as u64).sum();
+    progress.total.store(total, Ordering::Relaxed);
+    let most = targets.iter().copied().max().unwrap_or(0);
+    let mut nonfinite = NonFinite::default();
+    let mut limit = pilot;
+    while limit < most && !progress.cancelled() {
+        limit = limit.saturating_mul(2).min(most);
+        let range = SampleRange {
+            first: pilot,
+            last: limit,
+            targets: Some(&targets),
+        };
+        nonfinite.merge(render_range(ctx, estimator, film, range, None, progress));
+        if progress.cancelled() {
+            break;
+        }
+        let taken: u64 = film.pixels.iter().map(|p| p.samples as u64).sum();
+        let mean = (taken / film.pixels.len().max(1) as u64) as u32;
+        control.after_pass(mean, film);
+    }
+    if !progress.cancelled() && budget.is_power_of_two() {
+        (control.snapshot)(budget, film);
+    }
+    nonfinite
 }
 
 /// A sample range past the first block: each block into a film of its own (no
@@ -181,47 +252,103 @@ fn render_pass<E: PixelEstimator>(
     count: u32,
     progress: &Progress,
 ) -> NonFinite {
-    let width = film.width;
-    let merge = |mut a: NonFinite, b: NonFinite| {
-        a.merge(b);
-        a
+    let range = SampleRange {
+        first,
+        last: first + count,
+        targets: None,
     };
-    let Film {
-        pixels, moments, ..
-    } = film;
-    let row = |row_index: usize, row: &mut [FilmPixel], moments: Option<&mut [[f64; 3]]>| {
-        render_row(
-            ctx, estimator, row_index, row, moments, first, count, progress,
-        )
-    };
-    match moments {
-        None => pixels
-            .par_chunks_mut(width)
-            .enumerate()
-            .map(|(y, r)| row(y, r, None))
-            .reduce(NonFinite::default, merge),
-        Some(m) => pixels
-            .par_chunks_mut(width)
-            .zip(m.par_chunks_mut(width))
-            .enumerate()
-            .map(|(y, (r, m))| row(y, r, Some(m)))
-            .reduce(NonFinite::default, merge),
+    render_range(ctx, estimator, film, range, None, progress)
+}
+
+/// Which samples a pass adds to each pixel: those of `first .. last` it does not have
+/// yet, and, with `targets` (one count per film pixel, row by row), none at or past the
+/// pixel's own target.
+#[derive(Clone, Copy)]
+struct SampleRange<'a> {
+    first: u32,
+    last: u32,
+    targets: Option<&'a [u32]>,
+}
+
+impl<'a> SampleRange<'a> {
+    /// The range for the pixels of row `y` of a `width`-wide film.
+    fn row(self, y: usize, width: usize) -> SampleRange<'a> {
+        SampleRange {
+            targets: self.targets.map(|t| &t[y * width..(y + 1) * width]),
+            ..self
+        }
+    }
+
+    /// One past the last sample of the row's pixel `column`.
+    fn last(&self, column: usize) -> u32 {
+        match self.targets {
+            Some(t) => t[column].min(self.last),
+            None => self.last,
+        }
     }
 }
 
-/// Adds samples `first .. first + count` to the pixels of the film's row `row_index`
-/// (and, when kept, their squares to `moments`).
-#[allow(clippy::too_many_arguments)]
+/// [`render_pass`] over a [`SampleRange`]; adds each sample's rays to its pixel in
+/// `rays`, when given (one count per film pixel).
+fn render_range<E: PixelEstimator>(
+    ctx: &RenderContext,
+    estimator: &E,
+    film: &mut Film,
+    range: SampleRange<'_>,
+    rays: Option<&mut [u32]>,
+    progress: &Progress,
+) -> NonFinite {
+    let width = film.width;
+    let Film {
+        pixels, moments, ..
+    } = film;
+    // Per row, the row's slice of each optional per-pixel array.
+    fn rows<T>(values: Option<&mut [T]>, width: usize, height: usize) -> Vec<Option<&mut [T]>> {
+        match values {
+            Some(v) => v.chunks_mut(width).map(Some).collect(),
+            None => (0..height).map(|_| None).collect(),
+        }
+    }
+    let height = pixels.len() / width.max(1);
+    let moment_rows = rows(moments.as_deref_mut(), width, height);
+    let ray_rows = rows(rays, width, height);
+    pixels
+        .par_chunks_mut(width)
+        .zip(moment_rows)
+        .zip(ray_rows)
+        .enumerate()
+        .map(|(y, ((row, moments), rays))| {
+            let extra = RowExtras { moments, rays };
+            render_row(ctx, estimator, y, row, extra, range.row(y, width), progress)
+        })
+        .reduce(NonFinite::default, |mut a, b| {
+            a.merge(b);
+            a
+        })
+}
+
+/// What a row's samples add to besides the film's sums: their squares (for the
+/// variance) and their ray counts (for adaptive sampling's cost), each when kept.
+struct RowExtras<'a> {
+    moments: Option<&'a mut [[f64; 3]]>,
+    rays: Option<&'a mut [u32]>,
+}
+
+/// Adds the samples of `range` to the pixels of the film's row `row_index` (and, when
+/// kept, their squares and rays to `extra`).
 fn render_row<E: PixelEstimator>(
     ctx: &RenderContext,
     estimator: &E,
     row_index: usize,
     row: &mut [FilmPixel],
-    mut moments: Option<&mut [[f64; 3]]>,
-    first: u32,
-    count: u32,
+    extra: RowExtras<'_>,
+    range: SampleRange<'_>,
     progress: &Progress,
 ) -> NonFinite {
+    let RowExtras {
+        mut moments,
+        rays: mut pixel_rays,
+    } = extra;
     let mut nonfinite = NonFinite::default();
     if progress.cancelled() {
         return nonfinite;
@@ -231,15 +358,18 @@ fn render_row<E: PixelEstimator>(
     let mut rays = 0u64;
     let mut row_samples = 0u64;
     let mut scratch = estimator.scratch();
-    let last = first + count;
     for (column, film_pixel) in row.iter_mut().enumerate() {
         let x = x0 + column as u32;
+        let last = range.last(column);
         let mut open = FilmPixel::default();
-        for index in film_pixel.samples.max(first)..last {
+        for index in film_pixel.samples.max(range.first)..last {
             let pixel = PixelId { x, y, index };
             row_samples += 1;
             let (l, weight, r) = sample_pixel(ctx, estimator, &mut scratch, pixel);
             rays += r as u64;
+            if let Some(counts) = pixel_rays.as_deref_mut() {
+                counts[column] = counts[column].saturating_add(r);
+            }
             let target = if index < SAMPLE_BLOCK {
                 &mut *film_pixel
             } else {
