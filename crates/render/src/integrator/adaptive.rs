@@ -2,9 +2,10 @@
 //! estimated error rather than evenly.
 //!
 //! A uniform pilot ([`pilot_samples`]) estimates each pixel's relative variance per
-//! sample, r = Var[L] / (E[L]² + ε), from the film's second moments. Minimising the
-//! expected relative MSE Σ r_i / n_i under a fixed total Σ n_i = N gives n_i ∝ √r_i
-//! (a Lagrange multiplier; the allocation behind greedy error minimisation, Rousselle,
+//! sample, r = Var[L] / (E[L]² + ε), from the film's second moments, and its cost c,
+//! the rays per sample. Minimising the expected relative MSE Σ r_i / n_i at a fixed
+//! cost Σ n_i c_i gives n_i ∝ √(r_i / c_i) (a Lagrange multiplier; with equal costs, the
+//! allocation behind greedy error minimisation, Rousselle,
 //! Knaus & Zwicker, "Adaptive Sampling and Reconstruction using Greedy Error
 //! Minimization", SIGGRAPH Asia 2011; survey: Zwicker et al., "Recent Advances in
 //! Adaptive Sampling and Reconstruction for Monte Carlo Rendering", EG STAR 2015).
@@ -19,10 +20,10 @@
 
 use radiant_image::Film;
 
-/// The ε of r = Var / (E² + ε): the denominator of the relative MSE the renders are
-/// scored by (`radiant compare`, Rousselle et al. 2011), in the sensor's units. It
-/// keeps black pixels from asking for unbounded work.
-pub const RELATIVE_EPSILON: f64 = 1e-2;
+/// The ε of r = Var / (E² + ε): that of the relative MSE the renders are scored by
+/// (`radiant compare`, Rousselle et al. 2011), in the sensor's units. It keeps black
+/// pixels from asking for unbounded work.
+pub const RELATIVE_EPSILON: f64 = radiant_image::metrics::RELMSE_EPSILON;
 
 /// No pixel takes more than this many times the mean samples per pixel.
 pub const MAX_RATIO: f64 = 8.0;
