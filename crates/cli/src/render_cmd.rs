@@ -528,12 +528,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         }
         let spp = if session.ctx.adaptive {
             let film = &output_data.film;
-            let most = film.pixels.iter().map(|p| p.samples).max().unwrap_or(0);
-            let taken: u64 = film.pixels.iter().map(|p| p.samples as u64).sum();
-            let mean = taken as f64 / film.pixels.len().max(1) as f64;
             format!(
-                "{mean:.1} spp adaptive ({}-{most} per pixel)",
-                output_data.spp_done
+                "{:.1} spp adaptive ({}-{} per pixel)",
+                film.mean_samples(),
+                output_data.spp_done,
+                film.max_samples()
             )
         } else {
             format!("{} spp", output_data.spp_done)

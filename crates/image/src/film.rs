@@ -218,6 +218,17 @@ impl Film {
     pub fn min_samples(&self) -> u32 {
         self.pixels.iter().map(|p| p.samples).min().unwrap_or(0)
     }
+
+    /// Samples taken in the pixel with the most.
+    pub fn max_samples(&self) -> u32 {
+        self.pixels.iter().map(|p| p.samples).max().unwrap_or(0)
+    }
+
+    /// Samples per pixel on average (an adaptive render's spp).
+    pub fn mean_samples(&self) -> f64 {
+        let taken: u64 = self.pixels.iter().map(|p| p.samples as u64).sum();
+        taken as f64 / self.pixels.len().max(1) as f64
+    }
 }
 
 #[cfg(test)]

@@ -63,34 +63,18 @@ fn adaptive_cornell_box_matches_the_reference_in_every_tile() {
     let passes: Vec<Image> = (1..=4)
         .map(|seed| {
             let out = adaptive_session(&desc, 128, seed, None).render(&Progress::default());
-            let samples: Vec<u32> = out.film.pixels.iter().map(|p| p.samples).collect();
-            let (lo, hi) = (samples.iter().min().unwrap(), samples.iter().max().unwrap());
+            let (lo, hi) = (out.film.min_samples(), out.film.max_samples());
             eprintln!("seed {seed}: samples per pixel {lo}..{hi}");
-            assert_eq!(*lo, pilot_samples(128));
+            assert_eq!(lo, pilot_samples(128));
             assert!(
-                *hi > 2 * 128,
+                hi > 2 * 128,
                 "the allocation should concentrate samples: max {hi}"
             );
             out.film.image()
         })
         .collect();
     let (own, mean) = TileStats::from_passes(&passes, TILE).unwrap();
-    let own_abs = {
-        let k = passes.len() as f64;
-        let mut sum = 0.0;
-        for i in 0..reference.pixels.len() {
-            for c in 0..3 {
-                let m = passes.iter().map(|p| p.pixels[i][c] as f64).sum::<f64>() / k;
-                let s2 = passes
-                    .iter()
-                    .map(|p| (p.pixels[i][c] as f64 - m).powi(2))
-                    .sum::<f64>()
-                    / (k - 1.0);
-                sum += s2 / k;
-            }
-        }
-        sum / (3.0 * reference.pixels.len() as f64)
-    };
+    let (own_abs, _) = common::per_pixel_variance(&passes, &reference);
     let ref_tiles = TileStats::from_image(&reference, TILE)
         .with_variance_of(&own)
         .scaled_variance(ref_rmse * ref_rmse / own_abs);
@@ -176,8 +160,7 @@ fn an_interrupted_adaptive_render_keeps_what_each_pixel_received() {
         .unwrap();
     eprintln!("watched after passes: {watched:?}");
     assert!(out.interrupted);
-    let least = out.film.pixels.iter().map(|p| p.samples).min().unwrap();
-    let most = out.film.pixels.iter().map(|p| p.samples).max().unwrap();
+    let (least, most) = (out.film.min_samples(), out.film.max_samples());
     assert_eq!(out.spp_done, least);
     assert!(least >= pilot, "{least}");
     assert!(most > pilot && most <= 2 * pilot, "{most}");

@@ -26,7 +26,7 @@
 
 mod common;
 
-use radiant::image::metrics::{RELMSE_EPSILON, compare};
+use radiant::image::metrics::compare;
 use radiant::image::tiles::{TileCriterion, TileStats, compare_tiles};
 use radiant::image::{Image, read_image};
 use radiant::render::Overrides;
@@ -40,27 +40,6 @@ const CRITERION: TileCriterion = TileCriterion {
     rel_floor: 0.003,
     abs_floor: 0.0,
 };
-
-/// Mean over pixels and channels of the passes' variance of their mean: (absolute,
-/// relative as in relMSE).
-fn per_pixel_variance(passes: &[Image], reference: &Image) -> (f64, f64) {
-    let k = passes.len() as f64;
-    let (mut abs, mut rel) = (0.0, 0.0);
-    for (i, r) in reference.pixels.iter().enumerate() {
-        for c in 0..3 {
-            let m = passes.iter().map(|p| p.pixels[i][c] as f64).sum::<f64>() / k;
-            let s2 = passes
-                .iter()
-                .map(|p| (p.pixels[i][c] as f64 - m).powi(2))
-                .sum::<f64>()
-                / (k - 1.0);
-            abs += s2 / k;
-            rel += s2 / k / ((r[c] as f64).powi(2) + RELMSE_EPSILON);
-        }
-    }
-    let n = 3.0 * reference.pixels.len() as f64;
-    (abs / n, rel / n)
-}
 
 fn check_against_reference(scene: &str, mask: &dyn Fn(&Image) -> Vec<bool>) {
     let reference = read_image(common::shared(&format!("refs/{scene}-256-ref.exr"))).unwrap();
@@ -77,7 +56,7 @@ fn check_against_reference(scene: &str, mask: &dyn Fn(&Image) -> Vec<bool>) {
         start.elapsed().as_secs_f64()
     );
     let (own, mean) = TileStats::from_passes(&passes, TILE).unwrap();
-    let (own_abs, own_rel) = per_pixel_variance(&passes, &reference);
+    let (own_abs, own_rel) = common::per_pixel_variance(&passes, &reference);
     let ref_tiles = TileStats::from_image(&reference, TILE)
         .with_variance_of(&own)
         .scaled_variance(ref_rmse * ref_rmse / own_abs);

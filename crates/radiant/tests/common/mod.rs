@@ -107,3 +107,24 @@ pub fn assert_tiles(name: &str, cmp: &radiant::image::TileComparison, test: &Ima
         panic!("{e}");
     }
 }
+
+/// Mean over pixels and channels of the passes' variance of their mean: (absolute,
+/// relative as in relMSE).
+pub fn per_pixel_variance(passes: &[Image], reference: &Image) -> (f64, f64) {
+    let k = passes.len() as f64;
+    let (mut abs, mut rel) = (0.0, 0.0);
+    for (i, r) in reference.pixels.iter().enumerate() {
+        for c in 0..3 {
+            let m = passes.iter().map(|p| p.pixels[i][c] as f64).sum::<f64>() / k;
+            let s2 = passes
+                .iter()
+                .map(|p| (p.pixels[i][c] as f64 - m).powi(2))
+                .sum::<f64>()
+                / (k - 1.0);
+            abs += s2 / k;
+            rel += s2 / k / ((r[c] as f64).powi(2) + radiant::image::metrics::RELMSE_EPSILON);
+        }
+    }
+    let n = 3.0 * reference.pixels.len() as f64;
+    (abs / n, rel / n)
+}

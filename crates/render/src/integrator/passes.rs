@@ -146,9 +146,10 @@ pub fn render_passes<E: PixelEstimator>(
 /// The adaptive phase after the pilot in `film`, which traced `pilot_rays` in each
 /// pixel: each pixel's target from [`adaptive::sample_targets`], reached in rounds that
 /// double the samples a pixel may have (2 × pilot, 4 × pilot, …), so that an
-/// interrupted render has spread its work over the image. The pass watcher sees the film after each round with the
-/// mean samples per pixel so far; the last round is a snapshot of `budget` samples per
-/// pixel on average when `budget` is a power of two.
+/// interrupted render has spread its work over the image. The pass watcher sees the
+/// film after each round with the mean samples per pixel so far (rounded down); the
+/// last round is a snapshot of `budget` samples per pixel on average when `budget` is a
+/// power of two.
 fn render_adaptive<E: PixelEstimator>(
     ctx: &RenderContext,
     estimator: &E,
@@ -176,9 +177,7 @@ fn render_adaptive<E: PixelEstimator>(
         if progress.cancelled() {
             break;
         }
-        let taken: u64 = film.pixels.iter().map(|p| p.samples as u64).sum();
-        let mean = (taken / film.pixels.len().max(1) as u64) as u32;
-        control.after_pass(mean, film);
+        control.after_pass(film.mean_samples() as u32, film);
     }
     if !progress.cancelled() && budget.is_power_of_two() {
         (control.snapshot)(budget, film);
