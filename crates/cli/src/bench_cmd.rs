@@ -190,6 +190,18 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
+/// cornell-box with `"integer primarysplit" 8`: its noise is the indirect light, so
+/// eight bounces per camera sample reach an error sooner (docs/speed.md).
+fn cornell_box_split_8() -> SceneDesc {
+    let mut desc = cornell_box();
+    desc.integrator.params = desc
+        .integrator
+        .params
+        .clone()
+        .with("primarysplit", ParamValue::Int(vec![8]));
+    desc
+}
+
 /// The canonical speed tasks, each as CPU seconds to its error (per seed and the
 /// median), and the path tracer's CPU seconds per 256 samples per pixel.
 fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
@@ -220,6 +232,16 @@ fn time_to_error_rows(refs: &Path, seeds: u64) -> anyhow::Result<()> {
             target: 6e-4,
             max_spp: 256,
             adaptive: true,
+        },
+        Task {
+            label: "cornell-box, path split 8 ways at the first vertex, to relMSE 6e-4",
+            scene: cornell_box_split_8,
+            integrator: "path",
+            reference: "cornell-box-256-ref.exr",
+            crop: None,
+            target: 6e-4,
+            max_spp: 64,
+            adaptive: false,
         },
         Task {
             label: "cornell-caustics caustic crop (x 160..192, y 232..244), sppm, to 4e-3",

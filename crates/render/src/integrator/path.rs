@@ -1,13 +1,18 @@
 //! The path tracer: radiance by random walks from the camera with next-event estimation
 //! and multiple importance sampling (Veach & Guibas 1995, power heuristic), Russian
 //! roulette and specular chains. An iterative loop carrying a throughput — no recursion.
+//! Optionally the first vertex's bounce is split k ways, each branch walked on by that
+//! loop (splitting, the counterpart of roulette: Arvo & Kirk, "Particle Transport and
+//! Image Synthesis", 1990).
 
 use crate::geometry::Ray;
 use crate::light::{Light, LightSampleContext};
-use crate::material::TransportMode;
+use crate::material::{Material, TransportMode};
 use crate::sampler::{ContinuedPair, PixelSample, SobolAnchor};
-use crate::world::{NO_LIGHT, World};
+use crate::world::{NO_LIGHT, SurfaceHit, World};
+use glam::Vec3;
 use radiant_math::color::Rgb;
+use radiant_math::frame::Frame;
 use radiant_math::sampling::power_heuristic;
 use radiant_scene::{IntegratorDesc, SceneError};
 
@@ -28,6 +33,11 @@ pub struct PathSettings {
     /// scene says `"float rrthreshold"` (a radiant parameter; 1 is pbrt-v4's and
     /// Mitsuba 3's rule).
     pub rr_threshold: f32,
+    /// `"integer primarysplit" [1]`: bounces taken from each camera ray's first vertex,
+    /// each followed to its own end and the k averaged (a radiant parameter). Worth it
+    /// where the indirect light is the noise and the camera ray and first hit are a
+    /// large share of a path's cost; docs/speed.md measures it.
+    pub primary_split: u32,
 }
 
 /// Russian roulette starts after this many bounces by default.
@@ -76,10 +86,18 @@ impl PathSettings {
                 format!("\"rrthreshold\" must be positive, got {rr_threshold}"),
             ));
         }
+        let primary_split = desc.params.count("primarysplit", 1)?;
+        if primary_split == 0 {
+            return Err(SceneError::at(
+                &desc.loc,
+                "\"primarysplit\" must be at least 1, got 0".to_string(),
+            ));
+        }
         Ok(PathSettings {
             max_depth: desc.params.count("maxdepth", 5)?,
             rr_depth: desc.params.count("rrdepth", DEFAULT_RR_DEPTH)?,
             rr_threshold,
+            primary_split,
         })
     }
 }
@@ -90,6 +108,7 @@ impl Default for PathSettings {
             max_depth: 5,
             rr_depth: DEFAULT_RR_DEPTH,
             rr_threshold: DEFAULT_RR_THRESHOLD,
+            primary_split: 1,
         }
     }
 }
@@ -106,14 +125,17 @@ impl Integrator for PathIntegrator {
     }
 
     fn render(&self, ctx: &RenderContext, control: &mut RenderControl<'_>) -> RenderOutput {
-        render_passes(
-            ctx,
-            &PathEstimator {
-                world: &ctx.world,
-                settings: &self.settings,
-            },
-            control,
-        )
+        let estimator = PathEstimator {
+            world: &ctx.world,
+            settings: &self.settings,
+        };
+        // Chosen once per render, so that the unsplit walk is compiled as if splitting
+        // did not exist.
+        if self.settings.primary_split > 1 {
+            render_passes(ctx, &SplitPathEstimator(estimator), control)
+        } else {
+            render_passes(ctx, &estimator, control)
+        }
     }
 }
 
@@ -134,7 +156,27 @@ impl PixelEstimator for PathEstimator<'_> {
         _pixel: PixelId,
         _scratch: &mut (),
     ) -> (Rgb, u32) {
-        radiance(self.world, self.settings, ray, sampler)
+        walk::<false>(self.world, self.settings, WalkStart::camera(ray), sampler)
+    }
+}
+
+/// [`PathEstimator`] with the first vertex's bounce taken `settings.primary_split` times.
+struct SplitPathEstimator<'a>(PathEstimator<'a>);
+
+impl PixelEstimator for SplitPathEstimator<'_> {
+    type Scratch = ();
+
+    fn scratch(&self) {}
+
+    fn radiance(
+        &self,
+        ray: Ray,
+        sampler: &mut PixelSample,
+        _pixel: PixelId,
+        _scratch: &mut (),
+    ) -> (Rgb, u32) {
+        let PathEstimator { world, settings } = self.0;
+        walk::<true>(world, settings, WalkStart::camera(ray), sampler)
     }
 }
 
@@ -142,25 +184,77 @@ impl PixelEstimator for PathEstimator<'_> {
 pub fn radiance(
     world: &World,
     settings: &PathSettings,
-    mut ray: Ray,
+    ray: Ray,
+    sampler: &mut PixelSample,
+) -> (Rgb, u32) {
+    if settings.primary_split > 1 {
+        walk::<true>(world, settings, WalkStart::camera(ray), sampler)
+    } else {
+        walk::<false>(world, settings, WalkStart::camera(ray), sampler)
+    }
+}
+
+/// Where a walk starts: its first ray and what the path carries along it.
+#[derive(Clone, Copy)]
+struct WalkStart {
+    ray: Ray,
+    beta: Rgb,
+    /// Product of eta^2 scalings at refractions, undone for Russian roulette decisions.
+    eta_scale: f32,
+    specular_bounce: bool,
+    prev_pdf: f32,
+    /// The previous vertex as a receiver, for the light-sampling density of what a
+    /// BSDF-sampled ray finds (with MIS, as its light samples were drawn).
+    prev_ctx: LightSampleContext,
+    /// Vertices shaded so far.
+    depth: u32,
+    /// The draw of the first bounce's direction, which the second vertex's draws continue.
+    first_direction: Option<SobolAnchor>,
+    /// Distance along the path from the camera, for texture footprints.
+    travelled: f32,
+}
+
+impl WalkStart {
+    #[inline(always)]
+    fn camera(ray: Ray) -> WalkStart {
+        WalkStart {
+            ray,
+            beta: Rgb::WHITE,
+            eta_scale: 1.0,
+            specular_bounce: true,
+            prev_pdf: 0.0,
+            prev_ctx: LightSampleContext::at_point(ray.o),
+            depth: 0,
+            first_direction: None,
+            travelled: 0.0,
+        }
+    }
+}
+
+/// Follows a path from `start` to its end: its radiance and the rays it traced. With
+/// `SPLIT` the walk ends at the first vertex's light sample and [`split_first_bounce`]
+/// takes the bounce from there.
+#[inline(always)]
+fn walk<const SPLIT: bool>(
+    world: &World,
+    settings: &PathSettings,
+    start: WalkStart,
     sampler: &mut PixelSample,
 ) -> (Rgb, u32) {
     let scene = world.scene_sphere();
+    let WalkStart {
+        mut ray,
+        mut beta,
+        mut eta_scale,
+        mut specular_bounce,
+        mut prev_pdf,
+        mut prev_ctx,
+        mut depth,
+        mut first_direction,
+        mut travelled,
+    } = start;
     let mut l = Rgb::BLACK;
-    let mut beta = Rgb::WHITE;
-    // Product of eta^2 scalings at refractions, undone for Russian roulette decisions.
-    let mut eta_scale = 1.0f32;
-    let mut specular_bounce = true;
-    let mut prev_pdf = 0.0f32;
-    // The previous vertex as a receiver, for the light-sampling density of what a
-    // BSDF-sampled ray finds (with MIS, as its light samples were drawn).
-    let mut prev_ctx = LightSampleContext::at_point(ray.o);
     let mut rays = 0u32;
-    let mut depth = 0u32;
-    // The draw of the first bounce's direction, which the second vertex's draws continue.
-    let mut first_direction: Option<SobolAnchor> = None;
-    // Distance along the path from the camera, for texture footprints.
-    let mut travelled = 0.0f32;
     loop {
         rays += 1;
         let Some(hit) = world.intersect_with_footprint(&ray, f32::INFINITY, travelled) else {
@@ -235,6 +329,22 @@ pub fn radiance(
             }
         }
 
+        if SPLIT {
+            let vertex = FirstVertex {
+                hit: &hit,
+                material: &material,
+                frame: &frame,
+                wo_world,
+                wo,
+                beta,
+                travelled,
+            };
+            let (split_l, split_rays) = split_first_bounce(world, settings, &vertex, sampler);
+            l += split_l;
+            rays += split_rays;
+            break;
+        }
+
         let u_lobe = sampler.get_1d_if(material.uses_lobe_sample());
         let u_dir = match continued {
             Some(anchor) => sampler.get_2d_continuing(anchor, ContinuedPair::Second),
@@ -290,6 +400,104 @@ pub fn radiance(
     (l, rays)
 }
 
+/// The first vertex of a path, shaded and its light sample taken, before its bounce.
+struct FirstVertex<'a> {
+    hit: &'a SurfaceHit,
+    material: &'a Material,
+    frame: &'a Frame,
+    wo_world: Vec3,
+    wo: Vec3,
+    beta: Rgb,
+    travelled: f32,
+}
+
+/// The first vertex's bounce taken `settings.primary_split` = k times, each branch
+/// walked to its end with a sampler of its own; their radiance averaged, and the rays
+/// they traced.
+///
+/// The branches share the camera ray, the first hit and its light sample, and average
+/// the indirect light, where a closed room's noise is. Branch j of camera sample i
+/// draws as sample i·k + j of the pixel ([`PixelSample::branch`]), so that the k
+/// branches of n camera samples stratify the bounces as n·k samples would. A branch
+/// draws its bounce and roulette as the unsplit walk does at the first vertex, so that
+/// with k = 1 the two would trace the same path.
+#[inline(never)]
+fn split_first_bounce(
+    world: &World,
+    settings: &PathSettings,
+    vertex: &FirstVertex<'_>,
+    sampler: &PixelSample,
+) -> (Rgb, u32) {
+    let k = settings.primary_split;
+    let &FirstVertex {
+        hit,
+        material,
+        frame,
+        wo_world,
+        wo,
+        beta,
+        travelled,
+    } = vertex;
+    let mut sum = Rgb::BLACK;
+    let mut rays = 0u32;
+    for j in 0..k {
+        let mut branch = sampler.branch(k, j);
+        let u_lobe = branch.get_1d_if(material.uses_lobe_sample());
+        let (u_dir, anchor) = branch.get_2d_as_anchor();
+        let Some(bs) = material.sample(wo, u_lobe, u_dir, TransportMode::Radiance) else {
+            continue;
+        };
+        let wi = frame.to_world(bs.wi);
+        if !bs.specular && !direct::sides_agree(hit, wo_world, wi, wo, bs.wi) {
+            continue;
+        }
+        let mut branch_beta = beta * bs.f * (bs.wi.z.abs() / bs.pdf);
+        let mut eta_scale = 1.0;
+        if let Some(eta) = material.dielectric_eta()
+            && wi.dot(hit.ng) * wo_world.dot(hit.ng) < 0.0
+        {
+            eta_scale = if wo_world.dot(hit.ng) > 0.0 {
+                eta * eta
+            } else {
+                1.0 / (eta * eta)
+            };
+        }
+        let rr_beta = branch_beta.max_component() * eta_scale / settings.rr_threshold;
+        let roulette = 1 > settings.rr_depth && rr_beta < 1.0;
+        let u_rr = branch.get_1d_if(roulette);
+        if roulette {
+            let q = (1.0 - rr_beta).max(0.0);
+            if u_rr < q {
+                continue;
+            }
+            branch_beta /= 1.0 - q;
+        }
+        if branch_beta.is_black() {
+            continue;
+        }
+        let start = WalkStart {
+            ray: hit.spawn_ray(wi),
+            beta: branch_beta,
+            eta_scale,
+            specular_bounce: bs.specular,
+            prev_pdf: bs.pdf,
+            prev_ctx: LightSampleContext {
+                p: hit.p,
+                n: hit.ng,
+                ns: hit.ns,
+                mis_with_bsdf: true,
+            },
+            depth: 1,
+            first_direction: Some(anchor),
+            travelled,
+        };
+        let (l, r) = walk::<false>(world, settings, start, &mut branch);
+        sum += l;
+        rays += r;
+    }
+    (sum * (1.0 / k as f32), rays)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -310,6 +518,80 @@ mod tests {
         );
         let s = settings(r#"Integrator "path" "integer rrdepth" 4 "float rrthreshold" 1"#).unwrap();
         assert_eq!((s.rr_depth, s.rr_threshold), (4, 1.0));
+    }
+
+    #[test]
+    fn primary_split_defaults_to_one_and_zero_is_an_error_at_its_integrator() {
+        assert_eq!(settings(r#"Integrator "path""#).unwrap().primary_split, 1);
+        let s = settings(r#"Integrator "path" "integer primarysplit" 6"#).unwrap();
+        assert_eq!(s.primary_split, 6);
+        let e = settings(r#"Integrator "path" "integer primarysplit" 0"#)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("rr.pbrt:1:") && e.contains("primarysplit"),
+            "{e}"
+        );
+    }
+
+    /// The split walk with one branch traces the unsplit walk's path: the same draws
+    /// (branch 0 of 1 is the sample itself), the same throughput, roulette and MIS state
+    /// handed to the rest of the walk, so the same radiance up to the order of the sums
+    /// and the same rays. Through glass and a mirror, with roulette from the first
+    /// bounce, and with the Sobol (continued draws) and Halton samplers.
+    #[test]
+    fn one_branch_of_the_split_walk_is_the_unsplit_walk() {
+        let path = radiant_testkit::repo_path("scenes/cornell-caustics.pbrt");
+        let desc = radiant_scene::parse_file(&path).expect("parses");
+        let world = World::build(&desc).expect("builds").0;
+        let settings = PathSettings {
+            max_depth: 100,
+            rr_depth: 0,
+            rr_threshold: 1.0,
+            primary_split: 1,
+        };
+        let kinds = [
+            radiant_scene::SamplerKind::Sobol,
+            radiant_scene::SamplerKind::Halton {
+                randomization: radiant_scene::DigitRandomization::Owen,
+            },
+        ];
+        let (mut nonzero, mut compared) = (0, 0);
+        for kind in kinds {
+            for i in 0..4000u32 {
+                let sample = PixelSample::new(kind, 7, i % 61, i / 61, i % 16);
+                // Rays from inside the box towards its walls, blocks, glass and mirror.
+                let mut u =
+                    PixelSample::for_stream(radiant_scene::SamplerKind::Independent, 1, 9, i);
+                let d = radiant_math::sampling::uniform_sphere(u.get_2d());
+                let ray = Ray::new(glam::Vec3::new(278.0, 300.0, 250.0), d);
+                let (a, rays_a) = walk::<false>(
+                    &world,
+                    &settings,
+                    WalkStart::camera(ray),
+                    &mut sample.clone(),
+                );
+                let (b, rays_b) = walk::<true>(
+                    &world,
+                    &settings,
+                    WalkStart::camera(ray),
+                    &mut sample.clone(),
+                );
+                assert_eq!(rays_a, rays_b, "sample {i}");
+                for (x, y) in [(a.r, b.r), (a.g, b.g), (a.b, b.b)] {
+                    assert!(
+                        (x - y).abs() <= 1e-5 * x.abs().max(1e-3),
+                        "sample {i}: {a:?} vs {b:?}"
+                    );
+                }
+                nonzero += (a.g > 0.0) as u32;
+                compared += 1;
+            }
+        }
+        assert!(
+            nonzero * 2 > compared,
+            "{nonzero} of {compared} paths carried light"
+        );
     }
 
     #[test]

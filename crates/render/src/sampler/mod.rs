@@ -68,6 +68,21 @@ impl PixelSample {
         }
     }
 
+    /// Branch `j` of `k` taken from this sample at its current dimension: the same pixel,
+    /// sample index `index · k + j` from here on. The k branches of a pixel's n samples
+    /// are then its first n·k samples in the dimensions that follow, as well stratified
+    /// as n·k samples would be (a stratified sampler, whose strata count is fixed, draws
+    /// the branches' numbers independently).
+    pub fn branch(&self, k: u32, j: u32) -> PixelSample {
+        let index = self.index.wrapping_mul(k).wrapping_add(j);
+        PixelSample {
+            index,
+            index_reversed: index.reverse_bits(),
+            in_stream: self.in_stream || matches!(self.kind, SamplerKind::Stratified { .. }),
+            ..self.clone()
+        }
+    }
+
     /// Skips to a dimension (for integrators that lay out dimensions per bounce).
     pub fn set_dimension(&mut self, dim: u32) {
         self.dim = dim;
