@@ -88,8 +88,9 @@ impl PathSettings {
         }
         let primary_split = desc.params.count("primarysplit", 1)?;
         if primary_split == 0 {
+            let loc = desc.params.lookup("primarysplit").map_or(&desc.loc, |p| &p.loc);
             return Err(SceneError::at(
-                &desc.loc,
+                loc,
                 "\"primarysplit\" must be at least 1, got 0".to_string(),
             ));
         }
