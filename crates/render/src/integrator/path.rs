@@ -88,7 +88,10 @@ impl PathSettings {
         }
         let primary_split = desc.params.count("primarysplit", 1)?;
         if primary_split == 0 {
-            let loc = desc.params.lookup("primarysplit").map_or(&desc.loc, |p| &p.loc);
+            let loc = desc
+                .params
+                .lookup("primarysplit")
+                .map_or(&desc.loc, |p| &p.loc);
             return Err(SceneError::at(
                 loc,
                 "\"primarysplit\" must be at least 1, got 0".to_string(),
