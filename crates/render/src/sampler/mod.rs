@@ -473,6 +473,48 @@ mod tests {
         }
     }
 
+    /// Branch j of k taken from sample i at dimension d draws there what sample i·k + j
+    /// draws: the k branches of a pixel's n samples are its first n·k samples in the
+    /// dimensions after the split, so their pairs are a (0, 2)-net as those samples'
+    /// are, and a branch's continued draws continue its own anchor. A stratified
+    /// sampler's strata are the n camera samples', so its branches draw independent
+    /// numbers instead, different from branch to branch.
+    #[test]
+    fn branches_draw_as_further_samples_of_their_pixel() {
+        let (n, k, d) = (16u32, 4u32, 5u32);
+        let mut branched = Vec::new();
+        for i in 0..n {
+            let mut s = PixelSample::new(SamplerKind::Sobol, 9, 3, 4, i);
+            s.set_dimension(d);
+            for j in 0..k {
+                let mut b = s.branch(k, j);
+                let (u, anchor) = b.get_2d_as_anchor();
+                let c = b.get_2d_continuing(anchor, ContinuedPair::Second);
+                let mut plain = PixelSample::new(SamplerKind::Sobol, 9, 3, 4, i * k + j);
+                plain.set_dimension(d);
+                let (pu, panchor) = plain.get_2d_as_anchor();
+                assert_eq!(
+                    (u, c),
+                    (pu, plain.get_2d_continuing(panchor, ContinuedPair::Second))
+                );
+                branched.push(vec![u.x, u.y]);
+            }
+        }
+        assert_eq!(t_value(&branched), 0);
+
+        let strata = SamplerKind::Stratified {
+            x: 4,
+            y: 4,
+            jitter: true,
+        };
+        let s = PixelSample::new(strata, 9, 3, 4, 5);
+        let draws: Vec<Vec2> = (0..k).map(|j| s.branch(k, j).get_2d()).collect();
+        for (j, u) in draws.iter().enumerate() {
+            assert!((0.0..1.0).contains(&u.x) && (0.0..1.0).contains(&u.y));
+            assert!(draws[..j].iter().all(|v| v != u), "branch {j} repeats");
+        }
+    }
+
     #[test]
     fn continued_draws_consume_their_dimension_and_other_samplers_draw_plainly() {
         let mut plain = PixelSample::new(SamplerKind::Independent, 3, 4, 5, 6);
