@@ -537,6 +537,17 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         } else {
             format!("{} spp", output_data.spp_done)
         };
+        // A split path tracer's samples are camera samples of k paths each.
+        let integrator: &dyn std::any::Any = session.integrator.as_ref();
+        let spp = match integrator.downcast_ref::<radiant::render::integrator::PathIntegrator>() {
+            Some(path) if path.settings.primary_split > 1 => {
+                format!(
+                    "{spp} x {} paths split at the first vertex",
+                    path.settings.primary_split
+                )
+            }
+            _ => spp,
+        };
         eprintln!(
             "{}: {}x{}, {spp}, {} integrator, {:.2} s, {:.2} Mrays/s",
             output.display(),

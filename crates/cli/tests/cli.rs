@@ -266,3 +266,54 @@ fn adaptive_sampling_renders_and_is_refused_where_it_cannot_work() {
         assert!(!dir.join("refused.exr").exists(), "{extra:?}");
     }
 }
+
+/// A scene that splits its paths at the first vertex renders, and the summary says what
+/// a sample is; a split of zero stops at the parameter with its file, line and column.
+#[test]
+fn split_renders_say_so_and_a_zero_split_is_located() {
+    let dir = temp_dir("split");
+    let scene =
+        std::fs::read_to_string(radiant_testkit::repo_path("scenes/cornell-box.pbrt")).unwrap();
+    let integrator = "Integrator \"path\" \"integer maxdepth\" [ 100 ]";
+    assert!(scene.contains(integrator));
+    for (k, name) in [(3, "split.pbrt"), (0, "zero.pbrt")] {
+        let text = scene.replace(
+            integrator,
+            &format!("{integrator} \"integer primarysplit\" [ {k} ]"),
+        );
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    let out = run(radiant().current_dir(&dir).args([
+        "render",
+        "split.pbrt",
+        "--spp",
+        "4",
+        "--resolution",
+        "32x24",
+        "-o",
+        "split.exr",
+    ]));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("4 spp x 3 paths split"), "{stderr}");
+    assert!(read_image(dir.join("split.exr")).unwrap().mean() > 0.0);
+
+    let out =
+        run(radiant()
+            .current_dir(&dir)
+            .args(["render", "zero.pbrt", "--quiet", "-o", "zero.exr"]));
+    let stderr = assert_clean_failure(&out, "primarysplit 0");
+    let line = scene
+        .lines()
+        .position(|l| l.starts_with(integrator))
+        .unwrap()
+        + 1;
+    let column = integrator.len() + 2;
+    assert!(
+        stderr.contains(&format!(
+            "zero.pbrt:{line}:{column}: error: \"primarysplit\""
+        )),
+        "{stderr}"
+    );
+    assert!(!dir.join("zero.exr").exists());
+}
