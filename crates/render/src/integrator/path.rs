@@ -367,15 +367,8 @@ fn walk<const SPLIT: bool>(
             break;
         }
         beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
-        if let Some(eta) = material.dielectric_eta()
-            && wi.dot(hit.ng) * wo_world.dot(hit.ng) < 0.0
-        {
-            // Refraction: track eta^2 so roulette sees the unscaled throughput.
-            eta_scale *= if wo_world.dot(hit.ng) > 0.0 {
-                eta * eta
-            } else {
-                1.0 / (eta * eta)
-            };
+        if let Some(scale) = refraction_scale(&material, hit.ng, wo_world, wi) {
+            eta_scale *= scale;
         }
         specular_bounce = bs.specular;
         prev_pdf = bs.pdf;
@@ -387,21 +380,52 @@ fn walk<const SPLIT: bool>(
         prev_ctx.mis_with_bsdf = true;
         ray = hit.spawn_ray(wi);
 
-        let rr_beta = beta.max_component() * eta_scale / settings.rr_threshold;
-        let roulette = depth > settings.rr_depth && rr_beta < 1.0;
-        let u_rr = sampler.get_1d_if(roulette);
-        if roulette {
-            let q = (1.0 - rr_beta).max(0.0);
-            if u_rr < q {
-                break;
-            }
-            beta /= 1.0 - q;
-        }
-        if beta.is_black() {
+        if !survives_roulette(settings, depth, &mut beta, eta_scale, sampler) {
             break;
         }
     }
     (l, rays)
+}
+
+/// The factor by which a refraction through `material` (from `wo_world` to `wi`, across
+/// the surface of normal `ng`) scales radiance, η² or 1/η²; `None` for anything else.
+/// Paths track its product so that roulette sees the unscaled throughput.
+#[inline(always)]
+fn refraction_scale(material: &Material, ng: Vec3, wo_world: Vec3, wi: Vec3) -> Option<f32> {
+    let eta = material.dielectric_eta()?;
+    if wi.dot(ng) * wo_world.dot(ng) >= 0.0 {
+        return None;
+    }
+    Some(if wo_world.dot(ng) > 0.0 {
+        eta * eta
+    } else {
+        1.0 / (eta * eta)
+    })
+}
+
+/// Russian roulette after the bounce at vertex `depth`: past `settings.rr_depth`, a path
+/// whose throughput `beta` (times `eta_scale`) is below the threshold survives with
+/// probability max channel / threshold and is reweighted. The number is drawn either
+/// way, so that later dimensions do not depend on it. False where the path ends.
+#[inline(always)]
+fn survives_roulette(
+    settings: &PathSettings,
+    depth: u32,
+    beta: &mut Rgb,
+    eta_scale: f32,
+    sampler: &mut PixelSample,
+) -> bool {
+    let rr_beta = beta.max_component() * eta_scale / settings.rr_threshold;
+    let roulette = depth > settings.rr_depth && rr_beta < 1.0;
+    let u_rr = sampler.get_1d_if(roulette);
+    if roulette {
+        let q = (1.0 - rr_beta).max(0.0);
+        if u_rr < q {
+            return false;
+        }
+        *beta /= 1.0 - q;
+    }
+    !beta.is_black()
 }
 
 /// The first vertex of a path, shaded and its light sample taken, before its bounce.
@@ -456,27 +480,8 @@ fn split_first_bounce(
             continue;
         }
         let mut branch_beta = beta * bs.f * (bs.wi.z.abs() / bs.pdf);
-        let mut eta_scale = 1.0;
-        if let Some(eta) = material.dielectric_eta()
-            && wi.dot(hit.ng) * wo_world.dot(hit.ng) < 0.0
-        {
-            eta_scale = if wo_world.dot(hit.ng) > 0.0 {
-                eta * eta
-            } else {
-                1.0 / (eta * eta)
-            };
-        }
-        let rr_beta = branch_beta.max_component() * eta_scale / settings.rr_threshold;
-        let roulette = 1 > settings.rr_depth && rr_beta < 1.0;
-        let u_rr = branch.get_1d_if(roulette);
-        if roulette {
-            let q = (1.0 - rr_beta).max(0.0);
-            if u_rr < q {
-                continue;
-            }
-            branch_beta /= 1.0 - q;
-        }
-        if branch_beta.is_black() {
+        let eta_scale = refraction_scale(material, hit.ng, wo_world, wi).unwrap_or(1.0);
+        if !survives_roulette(settings, 1, &mut branch_beta, eta_scale, &mut branch) {
             continue;
         }
         let start = WalkStart {
