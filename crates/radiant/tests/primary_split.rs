@@ -5,14 +5,10 @@
 mod common;
 
 use radiant::Session;
-use radiant::image::metrics::compare;
-use radiant::image::tiles::{TileCriterion, TileStats, compare_tiles};
-use radiant::image::{Image, read_image};
+use radiant::image::Image;
 use radiant::render::{Overrides, Progress};
 use radiant::scene::builtin::furnace;
 use radiant::scene::{DigitRandomization, ParamValue, SamplerKind, SceneDesc};
-
-const TILE: usize = 16;
 
 fn split(mut desc: SceneDesc, k: i32) -> SceneDesc {
     desc.integrator.params = desc
@@ -60,31 +56,11 @@ fn render_on(
 /// would show here.
 #[test]
 fn split_cornell_box_matches_the_reference_in_every_tile() {
-    let reference = read_image(common::shared("refs/cornell-box-256-ref.exr")).unwrap();
-    let ref_rmse = common::noise_figure("refs/cornell-box-256-ref.noise.txt", "ref_rmse_est");
     let desc = split(cornell(), 4);
     let passes: Vec<Image> = (1..=4)
         .map(|seed| render_on(&desc, 32, seed, None, 2))
         .collect();
-    let (own, mean) = TileStats::from_passes(&passes, TILE).unwrap();
-    let (own_abs, _) = common::per_pixel_variance(&passes, &reference);
-    let ref_tiles = TileStats::from_image(&reference, TILE)
-        .with_variance_of(&own)
-        .scaled_variance(ref_rmse * ref_rmse / own_abs);
-    let m = compare(&mean, &reference, None).unwrap();
-    let rel = (m.mean_test - m.mean_ref).abs() / m.mean_ref;
-    eprintln!(
-        "split 4: relMSE of the mean {:.3e}; mean {:.6} vs {:.6}",
-        m.relmse, m.mean_test, m.mean_ref
-    );
-    assert!(rel < 0.003, "mean {} vs {}", m.mean_test, m.mean_ref);
-    let criterion = TileCriterion {
-        k: 4.0,
-        rel_floor: 0.003,
-        abs_floor: 0.0,
-    };
-    let cmp = compare_tiles(&own, &ref_tiles, criterion, &|_, _| false).unwrap();
-    common::assert_tiles("split-cornell-box", &cmp, &mean);
+    common::assert_passes_match_reference("split-cornell-box", "cornell-box", &passes);
 }
 
 /// The furnace (Le / (1 − albedo) = 2 everywhere) split 3 ways, with roulette from the

@@ -128,3 +128,41 @@ pub fn per_pixel_variance(passes: &[Image], reference: &Image) -> (f64, f64) {
     let n = 3.0 * reference.pixels.len() as f64;
     (abs / n, rel / n)
 }
+
+/// Independent renders of the canonical scene `scene` (`passes`, one seed each) against
+/// its Mitsuba 3 reference: the image mean within 0.3 %, and every 16 × 16 tile within
+/// 4 standard errors plus 0.3 % (the criterion of `reference_images.rs`), the renders'
+/// tile variance measured from their spread and the reference's scaled from its noise
+/// figure in the same proportion.
+pub fn assert_passes_match_reference(name: &str, scene: &str, passes: &[Image]) {
+    use radiant::image::metrics::compare;
+    use radiant::image::tiles::{TileCriterion, TileStats, compare_tiles};
+    const TILE: usize = 16;
+    let reference =
+        radiant::image::read_image(shared(&format!("refs/{scene}-256-ref.exr"))).unwrap();
+    let ref_rmse = noise_figure(&format!("refs/{scene}-256-ref.noise.txt"), "ref_rmse_est");
+    let (own, mean) = TileStats::from_passes(passes, TILE).unwrap();
+    let (own_abs, _) = per_pixel_variance(passes, &reference);
+    let ref_tiles = TileStats::from_image(&reference, TILE)
+        .with_variance_of(&own)
+        .scaled_variance(ref_rmse * ref_rmse / own_abs);
+    let m = compare(&mean, &reference, None).unwrap();
+    let rel = (m.mean_test - m.mean_ref).abs() / m.mean_ref;
+    eprintln!(
+        "{name}: relMSE of the mean {:.3e}; mean {:.6} vs {:.6}",
+        m.relmse, m.mean_test, m.mean_ref
+    );
+    assert!(
+        rel < 0.003,
+        "{name}: mean {} vs {}",
+        m.mean_test,
+        m.mean_ref
+    );
+    let criterion = TileCriterion {
+        k: 4.0,
+        rel_floor: 0.003,
+        abs_floor: 0.0,
+    };
+    let cmp = compare_tiles(&own, &ref_tiles, criterion, &|_, _| false).unwrap();
+    assert_tiles(name, &cmp, &mean);
+}
