@@ -51,7 +51,7 @@ pub struct RenderArgs {
     /// Adaptive sampling: --spp becomes the mean samples per pixel; a uniform pilot of a
     /// quarter of them estimates each pixel's relative variance, and the rest go where
     /// it is highest (in proportion to its square root, 5x5-smoothed). Path tracer,
-    /// photon map and radiosity display; not with checkpoints or units.
+    /// photon map and radiosity display; whole images, not units.
     #[arg(long)]
     pub adaptive: bool,
     /// Image size as WIDTHxHEIGHT, overriding the film's.
@@ -284,16 +284,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     session.ctx.moments = variance;
     times.build = phase.elapsed().as_secs_f64();
     if args.adaptive {
-        // The adaptive phase needs the pilot's second moments, which checkpoints do not
-        // keep, and its counts come from the whole image, which a unit does not see.
+        // Its counts come from the whole image's pilot, which a unit does not see.
         if session.integrator.state_kind() != StateKind::Film {
             bail!(
                 "--adaptive: the {} integrator does not take its samples pixel by pixel",
                 session.integrator.name()
             );
-        }
-        if args.checkpoint.target().is_some() {
-            bail!("--adaptive does not combine with --checkpoint or --resume");
         }
         if args.unit.any() {
             bail!("--adaptive renders whole images, not a unit of one");
@@ -468,7 +464,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
                 }
             }
             None if warn => eprintln!(
-                "warning: no variance channels: the {} integrator (or a resumed render) keeps no per-sample moments",
+                "warning: no variance channels: the {} integrator (or the render this one resumed) kept no per-sample moments",
                 session.integrator.name()
             ),
             None => {}

@@ -134,6 +134,92 @@ fn path_sppm_and_photonmap_resume_bit_identically() {
     }
 }
 
+/// An adaptive render keeps its pilot's moments and rays, then its targets, in its
+/// checkpoints: stopped in the pilot (4 of its 16 samples per pixel) or after the first
+/// adaptive round, it resumes to the image of the render done in one go. The variance
+/// channels, which come from the same moments, survive the resume too.
+#[test]
+fn adaptive_renders_resume_bit_identically_in_the_pilot_and_after_it() {
+    let dir = temp_dir("adaptive");
+    let args = [
+        "render",
+        "cornell-box",
+        "--spp",
+        "64",
+        "--adaptive",
+        "--resolution",
+        "24x20",
+        "--quiet",
+    ];
+    stop_and_resume(&dir, "adaptive-pilot", &args, 4);
+    stop_and_resume(&dir, "adaptive-rounds", &args, 20);
+
+    // With variance channels: an EXR resumed from the pilot matches in every channel.
+    let straight = dir.join("variance-straight.exr");
+    let resumed = dir.join("variance-resumed.exr");
+    let ckpt = dir.join("variance.ckpt");
+    let with_variance = [&args[..], &["--aov", "variance", "--threads", "1", "-o"]].concat();
+    assert_ok(&run(&with_variance, &[&straight]), "variance straight");
+    let stop = [
+        &with_variance[..with_variance.len() - 1],
+        &["--stop-after", "8", "-o"],
+    ]
+    .concat();
+    let out = run(
+        &stop,
+        &[&dir.join("p.exr"), Path::new("--checkpoint"), &ckpt],
+    );
+    assert_refused(&out, "variance stopped");
+    let out = run(&with_variance, &[&resumed, Path::new("--resume"), &ckpt]);
+    assert_ok(&out, "variance resumed");
+    assert!(
+        !stderr_of(&out).contains("no variance"),
+        "{}",
+        stderr_of(&out)
+    );
+    let channels = |p: &Path| -> Vec<(String, Vec<u32>)> {
+        let exr = exr::prelude::read_all_flat_layers_from_file(p).unwrap();
+        exr.layer_data[0]
+            .channel_data
+            .list
+            .iter()
+            .map(|c| {
+                let bits = c.sample_data.values_as_f32().map(f32::to_bits).collect();
+                (c.name.to_string(), bits)
+            })
+            .collect()
+    };
+    let (a, b) = (channels(&straight), channels(&resumed));
+    assert!(
+        a.iter().any(|(n, _)| n.contains("Variance")),
+        "{:?}",
+        a.iter().map(|c| &c.0).collect::<Vec<_>>()
+    );
+    assert_eq!(a, b, "variance render resumed");
+
+    // Uniform and adaptive checkpoints are not each other's.
+    let uniform = dir.join("uniform.ckpt");
+    let plain: Vec<&str> = args
+        .iter()
+        .copied()
+        .filter(|a| *a != "--adaptive")
+        .collect();
+    let out = run(
+        &[&plain[..], &["--stop-after", "4", "-o"]].concat(),
+        &[&dir.join("u.pfm"), Path::new("--checkpoint"), &uniform],
+    );
+    assert_refused(&out, "uniform stopped");
+    let out = run(
+        &[&args[..], &["-o"]].concat(),
+        &[&dir.join("u2.pfm"), Path::new("--resume"), &uniform],
+    );
+    let e = assert_refused(&out, "uniform checkpoint resumed adaptively");
+    assert!(
+        e.contains("uniform sampling in the checkpoint, adaptive now"),
+        "{e}"
+    );
+}
+
 #[test]
 fn progressive_radiosity_resumes_bit_identically() {
     let dir = temp_dir("radiosity");

@@ -2,14 +2,14 @@
 //! disk, so that a run stopped by a signal or a time limit continues where it stopped
 //! and ends with the image an uninterrupted run makes, bit for bit.
 //!
-//! # Format (version 2)
+//! # Format (version 3)
 //!
 //! All numbers little-endian; floats are IEEE 754 bit patterns, so nothing is rounded.
 //!
 //! | bytes | content |
 //! |-------|---------|
 //! | 8     | magic `RADCKPT\n` |
-//! | 4     | format version, u32 (2) |
+//! | 4     | format version, u32 (3) |
 //! | 4     | header length H, u32 |
 //! | H     | header: UTF-8 text, one `key: value` per line |
 //! | 8     | payload length P, u64 |
@@ -17,17 +17,24 @@
 //! | 8     | checksum: FNV-1a (64 bit) of every byte before it |
 //!
 //! Header keys (readers ignore keys they do not know, so fields can be added):
-//! `kind` (`film`, `sppm` or `radiosity`), `software`, `scene` (16 hex digits: hash of
+//! `kind` (`film`, `adaptive-film`, `sppm` or `radiosity`), `software`, `scene` (16 hex digits: hash of
 //! the scene description, source locations left out), `integrator` (name),
 //! `settings` (hash of the integrator's parameters), `seed`, `spp`, `resolution`
-//! (`WxH`), `pixel-bounds` (`x0,x1,y0,y1`, half-open; the whole image), `done`
-//! (samples per pixel, iterations or shots complete, for people reading the file).
+//! (`WxH`), `adaptive` (`yes` for a render with `--adaptive`, else `no`),
+//! `pixel-bounds` (`x0,x1,y0,y1`, half-open; the whole image), `done` (samples per
+//! pixel, iterations or shots complete, for people reading the file).
 //!
 //! Payloads:
 //! - `film`: width u32, height u32, non-finite sample count u64, first non-finite pixel
 //!   x u32 and y u32 (`u32::MAX` for none); then per pixel in row-major order the
 //!   weighted sums r, g, b (f64), the weight sum (f64) and the samples taken (u32) —
-//!   36 bytes a pixel. The samples are those of indices `0..samples`.
+//!   36 bytes a pixel. The samples are those of indices `0..samples`. Then a u32, 1
+//!   when the film keeps second moments (for a variance channel or an adaptive
+//!   render's pilot), followed by each pixel's weighted sums of squares r, g, b (3 f64),
+//!   or 0. (Version 2 had no moments.)
+//! - `adaptive-film`: a `film` payload, then the rays each pixel's pilot samples traced
+//!   (u32 a pixel), then a u32, 1 when the pilot is done and each pixel's target count
+//!   follows (u32 a pixel), or 0.
 //! - `sppm`: iterations u32, width u32, height u32; then per pixel the direct-light
 //!   sums (3 f64), then the global and the caustic estimate, each τ (3 f64), N (f64)
 //!   and R² (f64) — 104 bytes a pixel. (Version 1 had one estimate, 64 bytes.)
@@ -46,12 +53,12 @@ use radiant_image::atomic::atomic_write;
 use radiant_image::{Film, FilmPixel, NonFinite};
 use radiant_radiosity::ProgressiveState;
 use radiant_render::RenderContext;
-use radiant_render::integrator::{IntegratorState, PhotonEstimate, SppmPixel};
+use radiant_render::integrator::{AdaptivePlan, IntegratorState, PhotonEstimate, SppmPixel};
 use radiant_scene::{IntegratorDesc, SceneDesc};
 use thiserror::Error;
 
 const MAGIC: &[u8; 8] = b"RADCKPT\n";
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 /// Bytes of one SPPM pixel in the payload.
 const SPPM_PIXEL_BYTES: usize = 104;
 
@@ -92,6 +99,8 @@ pub struct RunKey {
     pub seed: u64,
     pub spp: u32,
     pub resolution: (u32, u32),
+    /// Whether samples are spread by the pilot's error (`--adaptive`).
+    pub adaptive: bool,
 }
 
 impl RunKey {
@@ -105,6 +114,7 @@ impl RunKey {
             seed: ctx.seed,
             spp: ctx.spp,
             resolution: ctx.resolution,
+            adaptive: ctx.adaptive,
         }
     }
 
@@ -145,6 +155,14 @@ impl RunKey {
             out.push(format!(
                 "resolution {}x{} in the checkpoint, {}x{} now",
                 self.resolution.0, self.resolution.1, now.resolution.0, now.resolution.1
+            ));
+        }
+        if self.adaptive != now.adaptive {
+            let says = |a: bool| if a { "adaptive" } else { "uniform" };
+            out.push(format!(
+                "{} sampling in the checkpoint, {} now (--adaptive)",
+                says(self.adaptive),
+                says(now.adaptive)
             ));
         }
         out
@@ -194,6 +212,7 @@ pub enum State {
 impl State {
     pub fn kind(&self) -> &'static str {
         match self {
+            State::Render(IntegratorState::AdaptiveFilm { .. }) => "adaptive-film",
             State::Render(s) => s.kind().name(),
             State::Radiosity(_) => "radiosity",
         }
@@ -273,6 +292,11 @@ pub fn encode(key: &RunKey, state: &State) -> Vec<u8> {
     let _ = writeln!(header, "spp: {}", key.spp);
     let (w, h) = key.resolution;
     let _ = writeln!(header, "resolution: {w}x{h}");
+    let _ = writeln!(
+        header,
+        "adaptive: {}",
+        if key.adaptive { "yes" } else { "no" }
+    );
     let _ = writeln!(header, "pixel-bounds: 0,{w},0,{h}");
     let _ = writeln!(header, "done: {}", state.done());
     let payload = encode_payload(state);
@@ -294,21 +318,50 @@ fn put_f64s(out: &mut Vec<u8>, values: &[f64]) {
     }
 }
 
+fn put_u32s(out: &mut Vec<u8>, values: &[u32]) {
+    for v in values {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+}
+
+fn put_film(out: &mut Vec<u8>, film: &Film) {
+    out.reserve(28 + 60 * film.pixels.len());
+    out.extend_from_slice(&(film.width as u32).to_le_bytes());
+    out.extend_from_slice(&(film.height as u32).to_le_bytes());
+    out.extend_from_slice(&film.nonfinite.count.to_le_bytes());
+    let (x, y) = film.nonfinite.first_pixel.unwrap_or((u32::MAX, u32::MAX));
+    out.extend_from_slice(&x.to_le_bytes());
+    out.extend_from_slice(&y.to_le_bytes());
+    for p in &film.pixels {
+        put_f64s(out, &p.sum);
+        put_f64s(out, &[p.weight]);
+        out.extend_from_slice(&p.samples.to_le_bytes());
+    }
+    match &film.moments {
+        Some(moments) => {
+            out.extend_from_slice(&1u32.to_le_bytes());
+            for m in moments {
+                put_f64s(out, m);
+            }
+        }
+        None => out.extend_from_slice(&0u32.to_le_bytes()),
+    }
+}
+
 fn encode_payload(state: &State) -> Vec<u8> {
     let mut out = Vec::new();
     match state {
-        State::Render(IntegratorState::Film(film)) => {
-            out.reserve(24 + 36 * film.pixels.len());
-            out.extend_from_slice(&(film.width as u32).to_le_bytes());
-            out.extend_from_slice(&(film.height as u32).to_le_bytes());
-            out.extend_from_slice(&film.nonfinite.count.to_le_bytes());
-            let (x, y) = film.nonfinite.first_pixel.unwrap_or((u32::MAX, u32::MAX));
-            out.extend_from_slice(&x.to_le_bytes());
-            out.extend_from_slice(&y.to_le_bytes());
-            for p in &film.pixels {
-                put_f64s(&mut out, &p.sum);
-                put_f64s(&mut out, &[p.weight]);
-                out.extend_from_slice(&p.samples.to_le_bytes());
+        State::Render(IntegratorState::Film(film)) => put_film(&mut out, film),
+        State::Render(IntegratorState::AdaptiveFilm { film, plan }) => {
+            put_film(&mut out, film);
+            out.reserve(8 * plan.pilot_rays.len() + 4);
+            put_u32s(&mut out, &plan.pilot_rays);
+            match &plan.targets {
+                Some(targets) => {
+                    out.extend_from_slice(&1u32.to_le_bytes());
+                    put_u32s(&mut out, targets);
+                }
+                None => out.extend_from_slice(&0u32.to_le_bytes()),
             }
         }
         State::Render(IntegratorState::Sppm {
@@ -460,6 +513,11 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, CheckpointError> {
         seed: num("seed")?,
         spp: u32::try_from(num("spp")?).map_err(|_| bad("spp", field("spp").unwrap_or("")))?,
         resolution,
+        adaptive: match field("adaptive")? {
+            "yes" => true,
+            "no" => false,
+            v => return Err(bad("adaptive", v)),
+        },
     };
     let kind = field("kind")?;
     let mut p = Reader {
@@ -468,6 +526,11 @@ pub fn decode(bytes: &[u8]) -> Result<Checkpoint, CheckpointError> {
     };
     let state = match kind {
         "film" => State::Render(IntegratorState::Film(decode_film(&mut p, resolution)?)),
+        "adaptive-film" => {
+            let film = decode_film(&mut p, resolution)?;
+            let plan = decode_plan(&mut p, film.pixels.len())?;
+            State::Render(IntegratorState::AdaptiveFilm { film, plan })
+        }
         "sppm" => State::Render(decode_sppm(&mut p, resolution)?),
         "radiosity" => State::Radiosity(decode_radiosity(&mut p)?),
         other => {
@@ -526,7 +589,44 @@ fn decode_film(p: &mut Reader<'_>, resolution: (u32, u32)) -> Result<Film, Check
             samples: p.u32("a pixel")?,
         };
     }
+    match p.u32("the moments flag")? {
+        0 => {}
+        1 => {
+            let n = pixel_count(p, (width, height), resolution, 24)?;
+            let mut moments = vec![[0.0; 3]; n];
+            for m in &mut moments {
+                *m = p.f64x3("a pixel's moments")?;
+            }
+            film.moments = Some(moments);
+        }
+        v => return Err(CheckpointError::Payload(format!("moments flag {v}"))),
+    }
     Ok(film)
+}
+
+/// `n` u32 values.
+fn u32s(p: &mut Reader<'_>, n: usize, what: &str) -> Result<Vec<u32>, CheckpointError> {
+    let left = p.bytes.len() - p.at;
+    if n.checked_mul(4).is_none_or(|b| b > left) {
+        return Err(CheckpointError::Truncated(format!(
+            "{n} values of {what}, {left} bytes left"
+        )));
+    }
+    (0..n).map(|_| p.u32(what)).collect()
+}
+
+/// An adaptive render's plan for a film of `n` pixels.
+fn decode_plan(p: &mut Reader<'_>, n: usize) -> Result<AdaptivePlan, CheckpointError> {
+    let pilot_rays = u32s(p, n, "the pilot's rays")?;
+    let targets = match p.u32("the targets flag")? {
+        0 => None,
+        1 => Some(u32s(p, n, "the targets")?),
+        v => return Err(CheckpointError::Payload(format!("targets flag {v}"))),
+    };
+    Ok(AdaptivePlan {
+        pilot_rays,
+        targets,
+    })
 }
 
 fn decode_sppm(
@@ -611,6 +711,7 @@ mod tests {
             seed: 7,
             spp: 16,
             resolution: (3, 2),
+            adaptive: false,
         }
     }
 
@@ -626,6 +727,60 @@ mod tests {
             first_pixel: Some((1, 0)),
         };
         film
+    }
+
+    /// [`film`] with second moments.
+    fn film_with_moments() -> Film {
+        let mut film = film().with_moments();
+        for (i, m) in film.moments.iter_mut().flatten().enumerate() {
+            *m = [i as f64 * 0.3, 1e-300, f64::MAX];
+        }
+        film
+    }
+
+    fn adaptive_state(targets: Option<Vec<u32>>) -> State {
+        State::Render(IntegratorState::AdaptiveFilm {
+            film: film_with_moments(),
+            plan: AdaptivePlan {
+                pilot_rays: vec![7, 0, u32::MAX, 3, 9, 1],
+                targets,
+            },
+        })
+    }
+
+    fn moment_bits(f: &Film) -> Option<Vec<[u64; 3]>> {
+        f.moments
+            .as_ref()
+            .map(|m| m.iter().map(|v| v.map(f64::to_bits)).collect())
+    }
+
+    #[test]
+    fn moments_and_adaptive_plans_round_trip_bit_for_bit() {
+        let plain = encode(
+            &key(),
+            &State::Render(IntegratorState::Film(film_with_moments())),
+        );
+        let State::Render(IntegratorState::Film(f)) = decode(&plain).unwrap().state else {
+            panic!("not a film");
+        };
+        assert_eq!(moment_bits(&f), moment_bits(&film_with_moments()));
+        assert!(moment_bits(&f).is_some());
+        let adaptive_key = RunKey {
+            adaptive: true,
+            ..key()
+        };
+        for targets in [None, Some(vec![16, 16, 128, 40, 16, 64])] {
+            let state = adaptive_state(targets.clone());
+            let back = decode(&encode(&adaptive_key, &state)).unwrap();
+            assert_eq!(back.key, adaptive_key);
+            assert_eq!(back.state.kind(), "adaptive-film");
+            let State::Render(IntegratorState::AdaptiveFilm { film, plan }) = back.state else {
+                panic!("not an adaptive film");
+            };
+            assert_eq!(moment_bits(&film), moment_bits(&film_with_moments()));
+            assert_eq!(plan.pilot_rays, vec![7, 0, u32::MAX, 3, 9, 1]);
+            assert_eq!(plan.targets, targets);
+        }
     }
 
     #[test]
@@ -656,14 +811,20 @@ mod tests {
 
     #[test]
     fn every_truncation_and_flipped_byte_is_an_error() {
-        let bytes = encode(&key(), &State::Render(IntegratorState::Film(film())));
-        for n in 0..bytes.len() {
-            assert!(decode(&bytes[..n]).is_err(), "truncated to {n} bytes");
-        }
-        for i in 0..bytes.len() {
-            let mut b = bytes.clone();
-            b[i] ^= 0x40;
-            assert!(decode(&b).is_err(), "byte {i} flipped");
+        let states = [
+            State::Render(IntegratorState::Film(film())),
+            adaptive_state(Some(vec![1, 2, 3, 4, 5, 6])),
+        ];
+        for state in &states {
+            let bytes = encode(&key(), state);
+            for n in 0..bytes.len() {
+                assert!(decode(&bytes[..n]).is_err(), "truncated to {n} bytes");
+            }
+            for i in 0..bytes.len() {
+                let mut b = bytes.clone();
+                b[i] ^= 0x40;
+                assert!(decode(&b).is_err(), "byte {i} flipped");
+            }
         }
     }
 
@@ -678,6 +839,15 @@ mod tests {
         assert!(e.contains("seed 7 in the checkpoint, 8 now"), "{e}");
         assert!(e.contains("resolution 3x2"), "{e}");
         assert!(!e.contains("scene"), "{e}");
+        let adaptive = RunKey {
+            adaptive: true,
+            ..key()
+        };
+        let e = key().check(&adaptive).unwrap_err().to_string();
+        assert!(
+            e.contains("uniform sampling in the checkpoint, adaptive now"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -324,6 +324,8 @@ impl Partial {
             seed: num("seed")?,
             spp: num("spp")? as u32,
             resolution: (w, h),
+            // Units of a distributed render sample uniformly.
+            adaptive: false,
         };
         let white_balance = match field("white-balance")? {
             "none" => None,

@@ -51,6 +51,7 @@ impl Session {
             seed: self.ctx.seed,
             spp: self.ctx.spp,
             resolution: self.ctx.resolution,
+            adaptive: self.ctx.adaptive,
         }
     }
 

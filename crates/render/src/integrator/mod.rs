@@ -25,7 +25,9 @@ pub use passes::{PixelEstimator, PixelId, fold, render_passes};
 pub use path::{PathIntegrator, PathSettings};
 pub use photon::{PhotonMapIntegrator, PhotonMapStats, PhotonSettings, Visualize};
 pub use sppm::{SppmIntegrator, SppmSettings, SppmStats};
-pub use state::{CheckpointHook, IntegratorState, PhotonEstimate, SppmPixel, StateKind};
+pub use state::{
+    AdaptivePlan, CheckpointHook, IntegratorState, PhotonEstimate, SppmPixel, StateKind,
+};
 
 use crate::context::{Progress, RenderContext};
 use radiant_image::Film;

@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::{IntegratorState, RenderControl, RenderOutput, Stats, adaptive};
+use super::{AdaptivePlan, IntegratorState, RenderControl, RenderOutput, Stats, adaptive};
 use crate::context::{Progress, RenderContext, SAMPLE_BLOCK};
 use crate::geometry::Ray;
 use crate::sampler::PixelSample;
@@ -61,39 +61,87 @@ pub fn render_passes<E: PixelEstimator>(
     if first > 0 {
         return render_blocks(ctx, estimator, control, start);
     }
-    let mut film = match control.resume.take() {
-        Some(IntegratorState::Film(film))
-            if (film.width as u32, film.height as u32) == ctx.film_size() =>
-        {
-            Film {
-                sensor: ctx.sensor,
-                ..film
-            }
+    // An adaptive render is uniform up to its pilot, then spends the rest of the budget
+    // where the pilot saw the most error. It starts from a fresh film or from its own
+    // state; a uniform render's film resumed with `ctx.adaptive` is finished uniformly
+    // (its samples' rays were not counted).
+    let resumed = control
+        .resume
+        .take()
+        .filter(|s| s.resolution() == ctx.film_size());
+    let (mut film, plan) = match resumed {
+        Some(IntegratorState::Film(film)) => (film, None),
+        Some(IntegratorState::AdaptiveFilm { film, plan }) if ctx.adaptive => (film, Some(plan)),
+        Some(IntegratorState::AdaptiveFilm { film, .. }) => (film, None),
+        _ if ctx.adaptive => {
+            let film = ctx.new_film().with_moments();
+            let plan = AdaptivePlan {
+                pilot_rays: vec![0; film.pixels.len()],
+                targets: None,
+            };
+            (film, Some(plan))
         }
-        _ => ctx.new_film(),
+        _ => (ctx.new_film(), None),
     };
+    film.sensor = ctx.sensor;
     let (w, h) = (film.width as u64, film.height as u64);
     progress.total.store(w * h * end as u64, Ordering::Relaxed);
     let taken: u64 = film.pixels.iter().map(|p| p.samples.min(end) as u64).sum();
     progress.done.fetch_add(taken, Ordering::Relaxed);
-    // An adaptive render is uniform up to its pilot, then spends the rest of the budget
-    // where the pilot saw the most error. Its film needs second moments, which a resumed
-    // film (checkpoints keep none) lacks: that one is finished uniformly.
-    let adaptive = ctx.adaptive && (film.moments.is_some() || film.min_samples() == 0);
-    if adaptive && film.moments.is_none() {
-        film = film.with_moments();
-    }
-    let budget = end;
-    let end = if adaptive {
-        adaptive::pilot_samples(budget)
-    } else {
-        budget
+    let Some(mut plan) = plan.filter(|p| p.pilot_rays.len() == film.pixels.len()) else {
+        render_uniform(ctx, estimator, control, &mut film, end, None);
+        let state = control.final_state(|| IntegratorState::Film(film.clone()));
+        return output(film, state, start, progress);
     };
-    // The pilot's rays per pixel: the cost side of the allocation.
-    let mut pilot_rays = adaptive.then(|| vec![0u32; film.pixels.len()]);
+    let budget = end;
+    let pilot = adaptive::pilot_samples(budget);
+    if plan.targets.is_none() {
+        render_uniform(ctx, estimator, control, &mut film, pilot, Some(&mut plan));
+    }
+    if pilot < budget && !progress.cancelled() {
+        render_adaptive(ctx, estimator, control, &mut film, &mut plan, budget);
+    }
+    let state = control.final_state(|| IntegratorState::AdaptiveFilm {
+        film: film.clone(),
+        plan: plan.clone(),
+    });
+    output(film, state, start, progress)
+}
+
+/// The output of a render of the whole sample range into `film`, begun at `start`.
+fn output(
+    film: Film,
+    state: Option<IntegratorState>,
+    start: Instant,
+    progress: &Progress,
+) -> RenderOutput {
+    RenderOutput {
+        spp_done: film.min_samples(),
+        state,
+        film,
+        seconds: start.elapsed().as_secs_f64(),
+        rays: progress.rays.load(Ordering::Relaxed),
+        interrupted: progress.cancelled(),
+        stats: Stats::default(),
+        blocks: Vec::new(),
+    }
+}
+
+/// The uniform pass loop: every pixel of `film` up to `end` samples, in passes that
+/// double (1, 1, 2, 4, … [`SAMPLE_BLOCK`]), picked up where the film left off. With an
+/// adaptive `plan` (its pilot), each sample's rays are added to its pixel's count and
+/// checkpoints save the plan with the film.
+fn render_uniform<E: PixelEstimator>(
+    ctx: &RenderContext,
+    estimator: &E,
+    control: &mut RenderControl<'_>,
+    film: &mut Film,
+    end: u32,
+    mut plan: Option<&mut AdaptivePlan>,
+) {
+    let progress = control.progress;
     let mut spp_done = film.min_samples();
-    // The pass schedule of a fresh render (1, 1, 2, 4, … 64, 64, …), picked up where a
-    // resumed film left off; the image does not depend on it, the snapshots do.
+    // The image does not depend on the schedule, the snapshots do.
     let mut pass = if spp_done < 2 {
         1
     } else {
@@ -109,80 +157,87 @@ pub fn render_passes<E: PixelEstimator>(
             last: spp_done + n,
             targets: None,
         };
-        let rays = pilot_rays.as_deref_mut();
-        let nonfinite = render_range(ctx, estimator, &mut film, range, rays, progress);
+        let rays = plan.as_deref_mut().map(|p| p.pilot_rays.as_mut_slice());
+        let nonfinite = render_range(ctx, estimator, film, range, rays, progress);
         film.nonfinite.merge(nonfinite);
         if progress.cancelled() {
             break;
         }
         spp_done += n;
-        control.after_pass(spp_done, &film);
+        control.after_pass(spp_done, film);
         if spp_done.is_power_of_two() {
-            (control.snapshot)(spp_done, &film);
+            (control.snapshot)(spp_done, film);
         }
-        control.boundary(spp_done, &|| IntegratorState::Film(film.clone()));
+        let film = &*film;
+        match plan.as_deref() {
+            Some(plan) => control.boundary(spp_done, &|| IntegratorState::AdaptiveFilm {
+                film: film.clone(),
+                plan: plan.clone(),
+            }),
+            None => control.boundary(spp_done, &|| IntegratorState::Film(film.clone())),
+        }
         if spp_done >= 2 {
             pass = (pass * 2).min(SAMPLE_BLOCK);
         }
     }
-    if adaptive && end < budget && !progress.cancelled() {
-        let rays = pilot_rays.as_deref().unwrap_or(&[]);
-        let nonfinite = render_adaptive(ctx, estimator, control, &mut film, rays, budget);
-        film.nonfinite.merge(nonfinite);
-    }
-    let interrupted = progress.cancelled();
-    RenderOutput {
-        spp_done: film.min_samples(),
-        state: control.final_state(|| IntegratorState::Film(film.clone())),
-        film,
-        seconds: start.elapsed().as_secs_f64(),
-        rays: progress.rays.load(Ordering::Relaxed),
-        interrupted,
-        stats: Stats::default(),
-        blocks: Vec::new(),
-    }
 }
 
-/// The adaptive phase after the pilot in `film`, which traced `pilot_rays` in each
-/// pixel: each pixel's target from [`adaptive::sample_targets`], reached in rounds that
+/// The adaptive phase after the pilot in `film`: each pixel's target from
+/// [`adaptive::sample_targets`] (chosen once, kept in `plan`), reached in rounds that
 /// double the samples a pixel may have (2 × pilot, 4 × pilot, …), so that an
-/// interrupted render has spread its work over the image. The pass watcher sees the
-/// film after each round with the mean samples per pixel so far (rounded down); the
-/// last round is a snapshot of `budget` samples per pixel on average when `budget` is a
-/// power of two.
+/// interrupted render has spread its work over the image. After each round the pass
+/// watcher sees the film with the mean samples per pixel so far (rounded down) and a
+/// checkpoint may save it; the last round is a snapshot of `budget` samples per pixel
+/// on average when `budget` is a power of two.
 fn render_adaptive<E: PixelEstimator>(
     ctx: &RenderContext,
     estimator: &E,
     control: &mut RenderControl<'_>,
     film: &mut Film,
-    pilot_rays: &[u32],
+    plan: &mut AdaptivePlan,
     budget: u32,
-) -> NonFinite {
+) {
     let progress = control.progress;
-    let pilot = film.min_samples();
-    let targets = adaptive::sample_targets(film, pilot_rays, budget, pilot);
+    let pilot = adaptive::pilot_samples(budget);
+    let targets = plan
+        .targets
+        .get_or_insert_with(|| adaptive::sample_targets(film, &plan.pilot_rays, budget, pilot))
+        .clone();
     let total: u64 = targets.iter().map(|&t| t as u64).sum();
     progress.total.store(total, Ordering::Relaxed);
+    let taken: u64 = film
+        .pixels
+        .iter()
+        .zip(&targets)
+        .map(|(p, &t)| p.samples.min(t) as u64)
+        .sum();
+    progress.done.store(taken, Ordering::Relaxed);
     let most = targets.iter().copied().max().unwrap_or(0);
-    let mut nonfinite = NonFinite::default();
     let mut limit = pilot;
     while limit < most && !progress.cancelled() {
         limit = limit.saturating_mul(2).min(most);
+        // Rounds a resumed film has already done add nothing.
         let range = SampleRange {
             first: pilot,
             last: limit,
             targets: Some(&targets),
         };
-        nonfinite.merge(render_range(ctx, estimator, film, range, None, progress));
+        let nonfinite = render_range(ctx, estimator, film, range, None, progress);
+        film.nonfinite.merge(nonfinite);
         if progress.cancelled() {
             break;
         }
-        control.after_pass(film.mean_samples() as u32, film);
+        let done = film.mean_samples() as u32;
+        control.after_pass(done, film);
+        let (film, plan) = (&*film, &*plan);
+        control.boundary(done, &|| IntegratorState::AdaptiveFilm {
+            film: film.clone(),
+            plan: plan.clone(),
+        });
     }
     if !progress.cancelled() && budget.is_power_of_two() {
         (control.snapshot)(budget, film);
     }
-    nonfinite
 }
 
 /// A sample range past the first block: each block into a film of its own (no

@@ -60,6 +60,11 @@ pub enum IntegratorState {
     /// samples continue, so a film stopped in the middle of a pass (some rows with
     /// more samples than others) resumes exactly too.
     Film(Film),
+    /// The film of an adaptive render (with the second moments its pilot keeps) and its
+    /// plan so far: during the pilot the rays each pixel traced, after it each pixel's
+    /// target. The targets are chosen once, from the pilot alone, so a resumed render
+    /// gives every pixel the samples the render done in one go gives it.
+    AdaptiveFilm { film: Film, plan: AdaptivePlan },
     /// SPPM after `iterations` complete iterations: the photon stream of the next one
     /// is derived from its index, so these statistics are all it needs.
     Sppm {
@@ -73,7 +78,7 @@ pub enum IntegratorState {
 impl IntegratorState {
     pub fn kind(&self) -> StateKind {
         match self {
-            IntegratorState::Film(_) => StateKind::Film,
+            IntegratorState::Film(_) | IntegratorState::AdaptiveFilm { .. } => StateKind::Film,
             IntegratorState::Sppm { .. } => StateKind::Sppm,
         }
     }
@@ -81,17 +86,30 @@ impl IntegratorState {
     /// Samples per pixel (SPPM: iterations) complete in every pixel.
     pub fn done(&self) -> u32 {
         match self {
-            IntegratorState::Film(film) => film.min_samples(),
+            IntegratorState::Film(film) | IntegratorState::AdaptiveFilm { film, .. } => {
+                film.min_samples()
+            }
             IntegratorState::Sppm { iterations, .. } => *iterations,
         }
     }
 
     pub fn resolution(&self) -> (u32, u32) {
         match self {
-            IntegratorState::Film(film) => (film.width as u32, film.height as u32),
+            IntegratorState::Film(film) | IntegratorState::AdaptiveFilm { film, .. } => {
+                (film.width as u32, film.height as u32)
+            }
             IntegratorState::Sppm { width, height, .. } => (*width, *height),
         }
     }
+}
+
+/// Where an adaptive render's allocation stands (see [`super::adaptive`]).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct AdaptivePlan {
+    /// Rays traced by each pixel's pilot samples so far, the cost side of the allocation.
+    pub pilot_rays: Vec<u32>,
+    /// Each pixel's sample count, once the pilot is done.
+    pub targets: Option<Vec<u32>>,
 }
 
 /// Called at every pass (SPPM: iteration) boundary with the samples per pixel done and
