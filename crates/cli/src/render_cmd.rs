@@ -91,7 +91,8 @@ pub struct CheckpointArgs {
     #[arg(long, value_name = "FILE")]
     pub resume: Option<PathBuf>,
     /// Stop (as if interrupted, saving the checkpoint) at the first pass boundary with
-    /// this many samples per pixel, iterations or shots done (for tests).
+    /// this many samples per pixel (an adaptive render's mean, after its pilot),
+    /// iterations or shots done (for tests).
     #[arg(long, value_name = "N", hide = true)]
     pub stop_after: Option<u32>,
 }
