@@ -65,9 +65,21 @@ fn assert_same_pixels(a: &Path, b: &Path, what: &str) {
 /// Renders straight at 1 thread; stops after `stop` passes (SPPM: iterations) at 1
 /// thread with a checkpoint; resumes at 2 threads; compares the pixels.
 fn stop_and_resume(dir: &Path, name: &str, args: &[&str], stop: u32) {
-    let straight = dir.join(format!("{name}-straight.pfm"));
-    let partial = dir.join(format!("{name}-partial.pfm"));
-    let resumed = dir.join(format!("{name}-resumed.pfm"));
+    stop_and_resume_as(dir, name, args, stop, "pfm");
+}
+
+/// [`stop_and_resume`] with images of extension `ext`; returns the straight and the
+/// resumed image and what the resumed run printed.
+fn stop_and_resume_as(
+    dir: &Path,
+    name: &str,
+    args: &[&str],
+    stop: u32,
+    ext: &str,
+) -> (PathBuf, PathBuf, String) {
+    let straight = dir.join(format!("{name}-straight.{ext}"));
+    let partial = dir.join(format!("{name}-partial.{ext}"));
+    let resumed = dir.join(format!("{name}-resumed.{ext}"));
     let ckpt = dir.join(format!("{name}.ckpt"));
     fn with<'a>(args: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
         args.iter().chain(extra).copied().collect()
@@ -95,6 +107,7 @@ fn stop_and_resume(dir: &Path, name: &str, args: &[&str], stop: u32) {
     );
     assert_ok(&out, name);
     assert_same_pixels(&straight, &resumed, name);
+    (straight, resumed, stderr_of(&out))
 }
 
 #[test]
@@ -155,28 +168,10 @@ fn adaptive_renders_resume_bit_identically_in_the_pilot_and_after_it() {
     stop_and_resume(&dir, "adaptive-rounds", &args, 20);
 
     // With variance channels: an EXR resumed from the pilot matches in every channel.
-    let straight = dir.join("variance-straight.exr");
-    let resumed = dir.join("variance-resumed.exr");
-    let ckpt = dir.join("variance.ckpt");
-    let with_variance = [&args[..], &["--aov", "variance", "--threads", "1", "-o"]].concat();
-    assert_ok(&run(&with_variance, &[&straight]), "variance straight");
-    let stop = [
-        &with_variance[..with_variance.len() - 1],
-        &["--stop-after", "8", "-o"],
-    ]
-    .concat();
-    let out = run(
-        &stop,
-        &[&dir.join("p.exr"), Path::new("--checkpoint"), &ckpt],
-    );
-    assert_refused(&out, "variance stopped");
-    let out = run(&with_variance, &[&resumed, Path::new("--resume"), &ckpt]);
-    assert_ok(&out, "variance resumed");
-    assert!(
-        !stderr_of(&out).contains("no variance"),
-        "{}",
-        stderr_of(&out)
-    );
+    let with_variance = [&args[..], &["--aov", "variance"]].concat();
+    let (straight, resumed, stderr) =
+        stop_and_resume_as(&dir, "variance", &with_variance, 8, "exr");
+    assert!(!stderr.contains("no variance"), "{stderr}");
     let channels = |p: &Path| -> Vec<(String, Vec<u32>)> {
         let exr = exr::prelude::read_all_flat_layers_from_file(p).unwrap();
         exr.layer_data[0]

@@ -70,13 +70,6 @@ fn adaptive_cornell_box_matches_the_reference_in_every_tile() {
     common::assert_passes_match_reference("adaptive-cornell-box", "cornell-box", &passes);
 }
 
-fn bits(img: &Image) -> Vec<[u32; 3]> {
-    img.pixels
-        .iter()
-        .map(|p| p.to_array().map(f32::to_bits))
-        .collect()
-}
-
 /// The pilot, the counts chosen from it and the samples after it are the same on one
 /// thread and two, so the image is too, bit for bit; and every pixel's count is the
 /// same.
@@ -89,7 +82,7 @@ fn adaptive_images_are_identical_at_one_and_two_threads() {
     assert_eq!(counts(&one.film), counts(&two.film));
     assert!(counts(&one.film).iter().any(|&n| n != 64));
     assert!(
-        bits(&one.film.image()) == bits(&two.film.image()),
+        common::pixel_bits(&one.film.image()) == common::pixel_bits(&two.film.image()),
         "images differ"
     );
 }

@@ -108,13 +108,6 @@ fn the_split_furnace_is_two_with_every_sampler() {
     }
 }
 
-fn bits(img: &Image) -> Vec<[u32; 3]> {
-    img.pixels
-        .iter()
-        .map(|p| p.to_array().map(f32::to_bits))
-        .collect()
-}
-
 /// A branch's numbers depend only on its sample and branch index, so a split render is
 /// the same on one thread and two, bit for bit; and it differs from the unsplit render
 /// of as many camera samples (it traces more paths), while `primarysplit 1` is that
@@ -125,8 +118,14 @@ fn split_images_are_identical_at_one_and_two_threads() {
     let desc = split(cornell(), 3);
     let one = render_on(&desc, 4, 5, res, 1);
     let two = render_on(&desc, 4, 5, res, 2);
-    assert!(bits(&one) == bits(&two), "images differ");
+    assert!(
+        common::pixel_bits(&one) == common::pixel_bits(&two),
+        "images differ"
+    );
     let unsplit = render_on(&cornell(), 4, 5, res, 2);
-    assert!(bits(&one) != bits(&unsplit));
-    assert!(bits(&render_on(&split(cornell(), 1), 4, 5, res, 2)) == bits(&unsplit));
+    assert!(common::pixel_bits(&one) != common::pixel_bits(&unsplit));
+    assert!(
+        common::pixel_bits(&render_on(&split(cornell(), 1), 4, 5, res, 2))
+            == common::pixel_bits(&unsplit)
+    );
 }

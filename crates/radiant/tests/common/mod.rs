@@ -8,6 +8,14 @@ use radiant::scene::SceneDesc;
 
 pub use radiant_testkit::shared;
 
+/// The image's pixels as f32 bit patterns, for bit-for-bit comparisons.
+pub fn pixel_bits(img: &Image) -> Vec<[u32; 3]> {
+    img.pixels
+        .iter()
+        .map(|p| p.to_array().map(f32::to_bits))
+        .collect()
+}
+
 /// Renders a scene with the given overrides on all cores.
 pub fn render(desc: &SceneDesc, overrides: &Overrides) -> Image {
     let session = Session::new(desc, overrides).expect("scene builds");
