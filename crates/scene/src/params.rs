@@ -208,6 +208,26 @@ impl ParamSet {
         }
     }
 
+    /// A finite float that must also satisfy `valid`; `requirement` says what that is
+    /// ("must be positive"), and the error names the parameter's location and value.
+    pub fn float_where(
+        &self,
+        name: &str,
+        default: f32,
+        requirement: &str,
+        valid: impl Fn(f32) -> bool,
+    ) -> Result<f32, SceneError> {
+        let v = self.finite_float(name, default)?;
+        if valid(v) {
+            return Ok(v);
+        }
+        let loc = &self.lookup(name).expect("a default is valid").loc;
+        Err(SceneError::at(
+            loc,
+            format!("parameter \"{name}\" {requirement}, got {v}"),
+        ))
+    }
+
     /// Marks every parameter as used (one "unsupported" warning then covers them all).
     pub fn mark_all_used(&self) {
         self.params.iter().for_each(Param::mark_used);

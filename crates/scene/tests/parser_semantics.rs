@@ -605,6 +605,108 @@ fn bad_values_are_errors_at_their_location() {
     }
 }
 
+/// Values outside what the quantity can be: an error at the parameter, naming the value.
+#[test]
+fn out_of_range_light_camera_and_film_values_are_errors_at_the_parameter() {
+    let spot = |params: &str| {
+        format!("WorldBegin\nLightSource \"spot\" \"point3 from\" [ 0 0 -1 ]\n  {params}\n")
+    };
+    for (text, at, words) in [
+        (
+            spot("\"float coneangle\" 0 \"float conedeltaangle\" 0"),
+            "t.pbrt:3:3:",
+            "\"coneangle\" must lie in (0, 180]",
+        ),
+        (spot("\"float coneangle\" -20"), "t.pbrt:3:3:", "got -20"),
+        (spot("\"float coneangle\" 500"), "t.pbrt:3:3:", "got 500"),
+        (
+            spot("\"float coneangle\" 20 \"float conedeltaangle\" -5"),
+            "t.pbrt:3:24:",
+            "\"conedeltaangle\" must lie in [0, coneangle = 20]",
+        ),
+        (
+            spot("\"float coneangle\" 20 \"float conedeltaangle\" 30"),
+            "t.pbrt:3:24:",
+            "got 30",
+        ),
+        (
+            "WorldBegin\nLightSource \"point\" \"float scale\" -1\n".to_string(),
+            "t.pbrt:2:21:",
+            "\"scale\" must not be negative",
+        ),
+        (
+            "WorldBegin\nAreaLightSource \"diffuse\" \"rgb scale\" [ 1 -1 1 ]\n".to_string(),
+            "t.pbrt:2:27:",
+            "\"scale\" must not be negative",
+        ),
+        (
+            "Film \"rgb\" \"float iso\" -100\n".to_string(),
+            "t.pbrt:1:12:",
+            "\"iso\" must be positive, got -100",
+        ),
+        (
+            "Film \"rgb\" \"float diagonal\" 0\n".to_string(),
+            "t.pbrt:1:12:",
+            "\"diagonal\" must be positive",
+        ),
+        (
+            "Camera \"perspective\" \"float lensradius\" -0.1\n".to_string(),
+            "t.pbrt:1:22:",
+            "\"lensradius\" must not be negative, got -0.1",
+        ),
+        (
+            "Camera \"orthographic\" \"float lensradius\" 0.1 \"float focaldistance\" 0\n"
+                .to_string(),
+            "t.pbrt:1:46:",
+            "\"focaldistance\" must be positive, got 0",
+        ),
+    ] {
+        let e = err(&text);
+        assert!(
+            e.starts_with(at) && e.contains(words),
+            "{text:?}: expected {at} … {words}, got {e}"
+        );
+    }
+}
+
+/// pbrt-v4 ignores a `power` or `illuminance` that is not positive; radiant does too,
+/// and says so where the value is written.
+#[test]
+fn a_power_that_is_not_positive_is_ignored_with_a_warning() {
+    let s = parse(
+        "WorldBegin\nLightSource \"point\" \"rgb I\" [ 1 2 3 ]\n  \"float power\" -5\n\
+         LightSource \"distant\" \"float illuminance\" 0\n\
+         AreaLightSource \"diffuse\" \"float power\" -1\n\
+         LightSource \"spot\" \"float coneangle\" 3\n",
+    );
+    let at: Vec<(u32, u32)> = s
+        .warnings
+        .iter()
+        .map(|w| (w.loc.line, w.loc.column))
+        .collect();
+    assert_eq!(at, vec![(3, 3), (4, 23), (5, 27)], "{:#?}", s.warnings);
+    assert!(
+        s.warnings
+            .iter()
+            .all(|w| w.message.contains("is not positive; ignored"))
+    );
+    let LightDesc::Point { intensity, .. } = s.lights[0] else {
+        panic!()
+    };
+    assert_eq!(intensity, Rgb::new(1.0, 2.0, 3.0));
+    // A cone narrower than the default falloff of 5 degrees falls off over its width.
+    let LightDesc::Spot {
+        cos_falloff_start,
+        cos_total_width,
+        ..
+    } = s.lights[2]
+    else {
+        panic!()
+    };
+    assert_eq!(cos_falloff_start, 1.0);
+    assert_eq!(cos_total_width, 3f32.to_radians().cos());
+}
+
 #[test]
 fn infinite_light_with_an_image() {
     let dir = std::env::temp_dir().join(format!("radiant-envparse-{}", std::process::id()));

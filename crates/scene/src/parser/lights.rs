@@ -9,8 +9,9 @@
 //! otherwise.
 //!
 //! - `"point"`: `I` (white), `from` (0,0,0), `scale`, `power`.
-//! - `"spot"`: `I`, `from` (0,0,0), `to` (0,0,1), `coneangle` 30°, `conedeltaangle` 5°,
-//!   `scale`, `power`.
+//! - `"spot"`: `I`, `from` (0,0,0), `to` (0,0,1), `coneangle` 30° (in (0°, 180°]),
+//!   `conedeltaangle` 5° (in [0, `coneangle`]; by default at most the cone, so that a
+//!   cone narrower than 5° falls off over its whole width), `scale`, `power`.
 //! - `"distant"`: `L`, `from` (0,0,0), `to` (0,0,1), `scale`, `illuminance`.
 //! - `"infinite"`: `L` (constant) or `filename` (a square equal-area octahedral image:
 //!   EXR, PFM or PNG), `scale`, `illuminance`; `portal` is read and ignored.
@@ -21,7 +22,9 @@
 //!   surface's (u, 1 − v)), `scale`, `twosided` (false), `power`.
 //!
 //! `power` and `illuminance` set the emission before `scale`, which multiplies the
-//! result (pbrt-v4 multiplies its scale by power / k_e).
+//! result (pbrt-v4 multiplies its scale by power / k_e). A `scale` may not be negative;
+//! a `power` or `illuminance` that is not positive is ignored, as pbrt-v4 ignores it,
+//! with a warning.
 
 use glam::Vec3;
 
@@ -81,13 +84,53 @@ impl Parser {
         if !s.is_finite() {
             return Err(SceneError::at(&p.loc, "light \"scale\" must be finite"));
         }
+        if s.min_component() < 0.0 {
+            return Err(SceneError::at(
+                &p.loc,
+                format!(
+                    "{owner}: \"scale\" must not be negative (a light cannot emit negative radiance)"
+                ),
+            ));
+        }
         Ok(s)
     }
 
-    /// An optional positive number (`power`, `illuminance`); pbrt's default is -1, off.
-    fn optional_positive(ps: &ParamSet, name: &str) -> Result<Option<f32>, SceneError> {
+    /// An optional positive number (`power`, `illuminance`). pbrt's default is -1, off,
+    /// and pbrt-v4 ignores any value that is not positive: so does radiant, but a value
+    /// written in the file that is ignored is reported.
+    fn optional_positive(
+        &mut self,
+        ps: &ParamSet,
+        name: &str,
+        owner: &str,
+    ) -> Result<Option<f32>, SceneError> {
         let v = ps.finite_float(name, -1.0)?;
+        if v <= 0.0
+            && let Some(p) = ps.lookup(name)
+        {
+            let at = p.loc.clone();
+            self.warn(
+                &at,
+                format!("{owner}: \"{name}\" {v} is not positive; ignored (the emission is used as given)"),
+            );
+        }
         Ok((v > 0.0).then_some(v))
+    }
+
+    /// The spot light's `coneangle` and `conedeltaangle` (degrees): the cone must have
+    /// a width, and its falloff must lie inside it, or the light has no solid angle to
+    /// spread its power over.
+    fn spot_cone(ps: &ParamSet) -> Result<(f32, f32), SceneError> {
+        let cone = ps.float_where("coneangle", 30.0, "must lie in (0, 180] degrees", |c| {
+            c > 0.0 && c <= 180.0
+        })?;
+        let delta = ps.float_where(
+            "conedeltaangle",
+            5.0f32.min(cone),
+            &format!("must lie in [0, coneangle = {cone}] degrees"),
+            |d| (0.0..=cone).contains(&d),
+        )?;
+        Ok((cone, delta))
     }
 
     pub(super) fn light_source(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
@@ -110,7 +153,7 @@ impl Parser {
                 let written =
                     self.spectrum_or(&ps, "I", SpectrumUse::Illuminant, Rgb::WHITE, &owner)?;
                 let i = written * scale;
-                let power = Self::optional_positive(&ps, "power")?;
+                let power = self.optional_positive(&ps, "power", &owner)?;
                 let from = ps.point3("from", Vec3::ZERO)?;
                 let position = ctm.point(from);
                 if name == "point" {
@@ -130,8 +173,7 @@ impl Parser {
                             format!("{owner}: \"from\" and \"to\" coincide"),
                         ));
                     }
-                    let cone = ps.finite_float("coneangle", 30.0)?;
-                    let delta = ps.finite_float("conedeltaangle", 5.0)?;
+                    let (cone, delta) = Self::spot_cone(&ps)?;
                     let cos_total_width = cone.to_radians().cos();
                     let cos_falloff_start = (cone - delta).to_radians().cos();
                     // Φ = 2π I [(1 - cos_start) + (cos_start - cos_end) / 2]: full
@@ -157,7 +199,7 @@ impl Parser {
                 let written =
                     self.spectrum_or(&ps, "L", SpectrumUse::Illuminant, Rgb::WHITE, &owner)?;
                 let l = written * scale;
-                let e = Self::optional_positive(&ps, "illuminance")?;
+                let e = self.optional_positive(&ps, "illuminance", &owner)?;
                 if name == "distant" {
                     let from = ps.point3("from", Vec3::ZERO)?;
                     let to = ps.point3("to", Vec3::Z)?;
@@ -183,7 +225,7 @@ impl Parser {
                 let scale = self.light_scale(&ps, &owner)?;
                 let i = self.spectrum_or(&ps, "I", SpectrumUse::Illuminant, Rgb::WHITE, &owner)?
                     * scale;
-                let power = scaled_target(Self::optional_positive(&ps, "power")?, scale);
+                let power = scaled_target(self.optional_positive(&ps, "power", &owner)?, scale);
                 let image = self.light_image(&ps)?;
                 if image.is_none() {
                     self.warn(
@@ -201,7 +243,7 @@ impl Parser {
             }
             "projection" => {
                 let scale = self.light_scale(&ps, &owner)?;
-                let power = scaled_target(Self::optional_positive(&ps, "power")?, scale);
+                let power = scaled_target(self.optional_positive(&ps, "power", &owner)?, scale);
                 let fov = ps.finite_float("fov", 90.0)?;
                 if !(fov > 0.0 && fov < 180.0) {
                     let at = ps.lookup("fov").map_or(loc.clone(), |p| p.loc.clone());
@@ -320,7 +362,7 @@ impl Parser {
             l,
             scale,
             two_sided: ps.bool("twosided", false)?,
-            power: Self::optional_positive(&ps, "power")?,
+            power: self.optional_positive(&ps, "power", &owner)?,
             image,
         };
         self.report_unused(&ps, &owner);

@@ -51,14 +51,14 @@ impl Parser {
                 }
                 CameraKind::Perspective {
                     fov_deg,
-                    lens_radius: ps.finite_float("lensradius", 0.0)?,
-                    focal_distance: ps.finite_float("focaldistance", 1e6)?,
+                    lens_radius: lens_radius(&ps)?,
+                    focal_distance: focal_distance(&ps)?,
                     screen_window: screen_window(&ps)?,
                 }
             }
             "orthographic" => CameraKind::Orthographic {
-                lens_radius: ps.finite_float("lensradius", 0.0)?,
-                focal_distance: ps.finite_float("focaldistance", 1e6)?,
+                lens_radius: lens_radius(&ps)?,
+                focal_distance: focal_distance(&ps)?,
                 screen_window: screen_window(&ps)?,
             },
             "realistic" => {
@@ -162,8 +162,8 @@ impl Parser {
             xresolution: resolution("xresolution", 1280)?,
             yresolution: resolution("yresolution", 720)?,
             filename: Some(ps.string("filename", "pbrt.exr".into())?),
-            diagonal_mm: ps.finite_float("diagonal", 35.0)?,
-            iso: ps.finite_float("iso", 100.0)?,
+            diagonal_mm: ps.float_where("diagonal", 35.0, "must be positive (mm)", |d| d > 0.0)?,
+            iso: ps.float_where("iso", 100.0, "must be positive", |iso| iso > 0.0)?,
             gbuffer,
             max_component_value: film_max_component(&ps)?,
             white_balance: None,
@@ -458,6 +458,16 @@ const CAMERA_SENSORS: [&str; 17] = [
     "sony_a7rm3",
     "sony_a9",
 ];
+
+/// The thin lens's `lensradius` (0, a pinhole, by default).
+fn lens_radius(ps: &ParamSet) -> Result<f32, SceneError> {
+    ps.float_where("lensradius", 0.0, "must not be negative", |r| r >= 0.0)
+}
+
+/// The distance of the plane in focus, `focaldistance` (pbrt's default 10⁶).
+fn focal_distance(ps: &ParamSet) -> Result<f32, SceneError> {
+    ps.float_where("focaldistance", 1e6, "must be positive", |d| d > 0.0)
+}
 
 /// `maxcomponentvalue` (default infinite), which must be positive.
 fn film_max_component(ps: &ParamSet) -> Result<f32, SceneError> {
