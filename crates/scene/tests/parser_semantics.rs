@@ -443,6 +443,43 @@ fn attribute_defaults_apply_to_later_shapes() {
 }
 
 #[test]
+fn attribute_parameters_nobody_reads_are_reported_once() {
+    let s = parse(
+        "WorldBegin\nAttribute \"shape\" \"float bogus1\" [ 1 ]\nAttribute \"light\" \"float bogus2\" 1\n\
+         Attribute \"material\" \"float bogus3\" 1\nAttribute \"shape\" \"float radius\" 2\n\
+         Attribute \"texture\" \"float uscale\" 4 \"float bogus4\" 1\n\
+         Texture \"c\" \"float\" \"checkerboard\"\nLightSource \"point\"\nShape \"sphere\"\nShape \"sphere\"\n",
+    );
+    let msgs: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(
+        msgs,
+        [
+            "t.pbrt:2:19: warning: parameter \"float bogus1\" of Attribute \"shape\" is not used by any later shape",
+            "t.pbrt:3:19: warning: parameter \"float bogus2\" of Attribute \"light\" is not used by any later light",
+            "t.pbrt:4:22: warning: parameter \"float bogus3\" of Attribute \"material\" is not used by any later material",
+            "t.pbrt:6:38: warning: parameter \"float bogus4\" of Attribute \"texture\" is not used by any later texture",
+        ]
+    );
+    let radius = |i: usize| match &s.shapes[i].geometry {
+        Geometry::Sphere { radius, .. } => *radius,
+        g => panic!("{g:?}"),
+    };
+    assert_eq!([radius(0), radius(1)], [2.0, 2.0]);
+}
+
+#[test]
+fn attribute_medium_is_ignored_with_a_warning_and_unknown_targets_refused() {
+    let s = parse("WorldBegin\nAttribute \"medium\" \"float g\" 0.5\n");
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert!(s.warnings[0].message.contains("media are not supported"));
+    let e = err("WorldBegin\nAttribute \"camera\" \"float fov\" 30\n");
+    assert!(
+        e.starts_with("t.pbrt:2:11: error: Attribute: unknown target \"camera\""),
+        "{e}"
+    );
+}
+
+#[test]
 fn point_and_spot_lights_follow_the_ctm_and_their_power() {
     let s = parse(
         "WorldBegin\nTranslate 0 10 0\n\

@@ -193,6 +193,8 @@ pub(super) struct Parser {
     /// `ObjectInstance` uses, resolved at the end (pbrt allows forward references).
     instance_uses: Vec<(String, Transform, FileLoc)>,
     notes_given: HashSet<&'static str>,
+    /// Every parameter `Attribute` gave, to report those nobody read.
+    attribute_params: Vec<blocks::AttributeParam>,
 
     camera: Option<CameraDesc>,
     film: Option<FilmDesc>,
@@ -237,6 +239,7 @@ impl Parser {
             object_index: HashMap::new(),
             instance_uses: Vec::new(),
             notes_given: HashSet::new(),
+            attribute_params: Vec::new(),
             camera: None,
             film: None,
             sampler: None,
@@ -522,6 +525,7 @@ impl Parser {
                 format!("{} without a matching end", open.kind.begin_name()),
             ));
         }
+        self.report_unused_attributes();
         let mut instances = Vec::with_capacity(self.instance_uses.len());
         for (name, transform, loc) in std::mem::take(&mut self.instance_uses) {
             let Some(&object) = self.object_index.get(&name) else {

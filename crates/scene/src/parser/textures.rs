@@ -19,6 +19,7 @@ use std::collections::hash_map::Entry;
 use glam::Vec3;
 
 use super::Parser;
+use super::state::with_defaults;
 use super::spectrum_param::{SpectrumUse, SpectrumValue};
 use crate::error::{FileLoc, SceneError};
 use crate::params::{ParamSet, ParamValue};
@@ -33,7 +34,7 @@ impl Parser {
         let (name, _) = self.string_arg("Texture")?;
         let (ty_name, ty_loc) = self.string_arg("Texture")?;
         let (class, _) = self.string_arg("Texture")?;
-        let ps = self.param_list()?;
+        let ps = with_defaults(self.param_list()?, &self.gs.defaults.texture);
         self.require_world("Texture", loc)?;
         let ty = match ty_name.as_str() {
             "float" => TextureType::Float,
