@@ -480,6 +480,27 @@ fn attribute_medium_is_ignored_with_a_warning_and_unknown_targets_refused() {
 }
 
 #[test]
+fn accelerators_are_accepted_with_a_warning_and_unknown_ones_refused() {
+    let s = parse(
+        "Accelerator \"bvh\"\nAccelerator \"kdtree\" \"integer maxprims\" 4\n\
+         Accelerator \"bvh\" \"float bogus0\" [ 1 ]\n",
+    );
+    let msgs: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(
+        msgs,
+        [
+            "t.pbrt:2:1: warning: Accelerator \"kdtree\": radiant always builds its own BVH; its parameter \"integer maxprims\" is ignored",
+            "t.pbrt:3:1: warning: Accelerator \"bvh\": radiant always builds its own BVH; its parameter \"float bogus0\" is ignored",
+        ]
+    );
+    let e = err("Accelerator \"octree\" \"float bogus0\" [ 1 ]\n");
+    assert!(
+        e.starts_with("t.pbrt:1:1: error: unknown accelerator \"octree\""),
+        "{e}"
+    );
+}
+
+#[test]
 fn point_and_spot_lights_follow_the_ctm_and_their_power() {
     let s = parse(
         "WorldBegin\nTranslate 0 10 0\n\
