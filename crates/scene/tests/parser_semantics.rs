@@ -664,6 +664,43 @@ fn bad_values_are_errors_at_their_location() {
 }
 
 #[test]
+fn value_errors_name_what_was_written() {
+    for (text, want) in [
+        (
+            "WorldBegin\nShape \"sphere\" \"float radius\" 1 \"float phimax\" [ -10 ]\n",
+            "t.pbrt:2:33: error: \"phimax\" must lie in (0, 360] degrees, got -10",
+        ),
+        (
+            "WorldBegin\nShape \"disk\" \"float phimax\" 0\n",
+            "t.pbrt:2:14: error: \"phimax\" must lie in (0, 360] degrees, got 0",
+        ),
+        (
+            "Film \"rgb\" \"integer xresolution\" [ 1e1 ]\n",
+            "t.pbrt:1:36: error: parameter \"integer xresolution\": an integer must be written without a fraction or exponent",
+        ),
+        (
+            "Film \"rgb\" \"integer xresolution\" 3000000000\n",
+            "t.pbrt:1:34: error: parameter \"integer xresolution\": 3000000000 does not fit a 32-bit integer",
+        ),
+        (
+            "Camera \"realistic\" \"string lensfile\" \".\"\n",
+            "t.pbrt:1:20: error: lens file './.' is a directory, not a file",
+        ),
+        (
+            "WorldBegin\nTexture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \".\"\n",
+            "t.pbrt:2:35: error: image './.' is a directory, not a file",
+        ),
+    ] {
+        assert_eq!(err(text), want, "{text:?}");
+    }
+    let s = parse("WorldBegin\nShape \"sphere\" \"float phimax\" 720\n");
+    assert!(matches!(
+        s.shapes[0].geometry,
+        Geometry::Sphere { phi_max_deg: 360.0, .. }
+    ));
+}
+
+#[test]
 fn infinite_light_with_an_image() {
     let dir = std::env::temp_dir().join(format!("radiant-envparse-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -162,6 +162,16 @@ pub(crate) fn read_text(path: &Path) -> Result<String, ReadError> {
     })
 }
 
+/// Why a file the scene names (an image, a lens) cannot be read as a file, or `None`
+/// when it can: a folder is said to be one rather than reported as missing.
+pub(crate) fn not_a_file(path: &Path) -> Option<&'static str> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => Some("is a directory, not a file"),
+        Ok(_) => None,
+        Err(_) => Some("not found"),
+    }
+}
+
 /// One file on the include stack.
 struct Source {
     lexer: Lexer,

@@ -71,10 +71,10 @@ impl Parser {
                     ));
                 }
                 let lens_file = self.resolve_path(&lens);
-                if !lens_file.is_file() {
+                if let Some(why) = super::not_a_file(&lens_file) {
                     return Err(SceneError::at(
                         &at,
-                        format!("lens file '{}' not found", lens_file.display()),
+                        format!("lens file '{}' {why}", lens_file.display()),
                     ));
                 }
                 if ps.has("aperture") {

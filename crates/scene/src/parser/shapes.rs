@@ -465,8 +465,22 @@ fn sphere(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
         radius,
         z_min: z_min.min(z_max),
         z_max: z_min.max(z_max),
-        phi_max_deg: ps.finite_float("phimax", 360.0)?.clamp(0.0, 360.0),
+        phi_max_deg: phi_max(ps)?,
     })
+}
+
+/// `phimax` in degrees: it must be positive; above 360 it is a full turn (pbrt-v4
+/// clamps it to [0, 360], but a turn of 0 degrees or less has no surface at all).
+fn phi_max(ps: &ParamSet) -> Result<f32, SceneError> {
+    let v = ps.finite_float("phimax", 360.0)?;
+    if v <= 0.0 {
+        let at = &ps.lookup("phimax").expect("present").loc;
+        return Err(SceneError::at(
+            at,
+            format!("\"phimax\" must lie in (0, 360] degrees, got {v}"),
+        ));
+    }
+    Ok(v.min(360.0))
 }
 
 fn disk(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
@@ -474,6 +488,6 @@ fn disk(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
         height: ps.finite_float("height", 0.0)?,
         radius: positive(ps, "radius", 1.0, false, loc)?,
         inner_radius: positive(ps, "innerradius", 0.0, true, loc)?,
-        phi_max_deg: ps.finite_float("phimax", 360.0)?.clamp(0.0, 360.0),
+        phi_max_deg: phi_max(ps)?,
     })
 }

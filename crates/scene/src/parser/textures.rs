@@ -266,10 +266,10 @@ impl Parser {
         };
         let file_loc = ps.lookup("filename").expect("present").loc.clone();
         let filename = self.resolve_path(&written);
-        if !filename.is_file() {
+        if let Some(why) = super::not_a_file(&filename) {
             return Err(SceneError::at(
                 &file_loc,
-                format!("image '{}' not found", filename.display()),
+                format!("image '{}' {why}", filename.display()),
             ));
         }
         let at = |name: &str| ps.lookup(name).map(|p| p.loc.clone());
