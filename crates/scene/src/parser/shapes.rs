@@ -396,6 +396,11 @@ fn uv_param(ps: &ParamSet, n: usize) -> Result<Option<Vec<Vec2>>, SceneError> {
 /// take tens of gigabytes).
 const MAX_SUBDIVIDED_TRIANGLES: u128 = 1 << 27;
 
+/// Peak memory of `loopsubdiv` per triangle it makes: one triangle subdivided 10 and
+/// 11 times peaks near 270 bytes per triangle for a whole render, of which about 100
+/// are the renderer's BVH.
+const SUBDIVISION_BYTES_PER_TRIANGLE: f64 = 180.0;
+
 fn loop_subdivision(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
     let levels = match ps.ints("levels")? {
         None => 3,
@@ -428,6 +433,17 @@ fn loop_subdivision(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError
             format!(
                 "\"levels\" {levels} would make {count} triangles (at most {MAX_SUBDIVIDED_TRIANGLES})"
             ),
+        ));
+    }
+    // The subdivision's working set (edge maps and vertex rings of the last level) is
+    // far larger than its result, so it is checked against the memory budget before
+    // any of it is made.
+    let bytes = count as f64 * SUBDIVISION_BYTES_PER_TRIANGLE;
+    if let Err(over) = crate::budget::check(bytes) {
+        let at = ps.lookup("levels").map_or(loc, |p| &p.loc).clone();
+        return Err(SceneError::at(
+            &at,
+            format!("\"levels\" {levels} would make {count} triangles, which need {over}"),
         ));
     }
     let s = subdiv::loop_subdivide(&positions, &indices, levels);
