@@ -244,6 +244,9 @@ impl Parser {
                 ),
             );
         }
+        for note in std::mem::take(&mut mesh.notes) {
+            self.warn(&at, format!("{owner}: {}: {note}", path.display()));
+        }
         if mesh.faces_skipped > 0 {
             self.warn(
                 &at,
