@@ -238,7 +238,11 @@ pub fn read_ply(path: &Path) -> Result<MeshData, SceneError> {
                         def.properties.keys().map(|k| format!("'{k}'")).collect();
                     return Err(fail(format!(
                         "the PLY 'face' element has no vertex index list (a list property named vertex_indices or vertex_index); its properties are {}",
-                        if seen.is_empty() { "none".to_string() } else { seen.join(", ") }
+                        if seen.is_empty() {
+                            "none".to_string()
+                        } else {
+                            seen.join(", ")
+                        }
                     )));
                 }
                 faces = Some(if ascii {

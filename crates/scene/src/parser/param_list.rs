@@ -203,8 +203,7 @@ fn typed_value(
                     }
                     // 1e1 or 10.0: an integer value, but not written as one (pbrt-v4
                     // refuses it too).
-                    None => "an integer must be written without a fraction or exponent"
-                        .to_string(),
+                    None => "an integer must be written without a fraction or exponent".to_string(),
                 };
                 return Err(SceneError::at(
                     &at,

@@ -19,8 +19,8 @@ use std::collections::hash_map::Entry;
 use glam::Vec3;
 
 use super::Parser;
-use super::state::with_defaults;
 use super::spectrum_param::{SpectrumUse, SpectrumValue};
+use super::state::with_defaults;
 use crate::error::{FileLoc, SceneError};
 use crate::params::{ParamSet, ParamValue};
 use crate::texture::{
