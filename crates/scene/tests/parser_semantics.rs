@@ -696,8 +696,28 @@ fn value_errors_name_what_was_written() {
     let s = parse("WorldBegin\nShape \"sphere\" \"float phimax\" 720\n");
     assert!(matches!(
         s.shapes[0].geometry,
-        Geometry::Sphere { phi_max_deg: 360.0, .. }
+        Geometry::Sphere {
+            phi_max_deg: 360.0,
+            ..
+        }
     ));
+}
+
+#[test]
+fn film_filenames_radiant_cannot_write_are_errors_at_the_parameter() {
+    for (name, want) in [
+        (
+            "out.tiff",
+            "t.pbrt:1:12: error: Film: cannot write \"out.tiff\": radiant writes .exr, .png and .pfm images",
+        ),
+        ("out", "t.pbrt:1:12: error: Film: cannot write \"out\""),
+        ("", "t.pbrt:1:12: error: Film: \"filename\" is empty"),
+    ] {
+        let e = err(&format!("Film \"rgb\" \"string filename\" \"{name}\"\n"));
+        assert!(e.starts_with(want), "{name:?}: {e}");
+    }
+    let s = parse("Film \"rgb\" \"string filename\" \"OUT.PNG\"\n");
+    assert_eq!(s.output_name(), "OUT.PNG");
 }
 
 #[test]

@@ -161,7 +161,7 @@ impl Parser {
         let film = FilmDesc {
             xresolution: resolution("xresolution", 1280)?,
             yresolution: resolution("yresolution", 720)?,
-            filename: Some(ps.string("filename", "pbrt.exr".into())?),
+            filename: Some(film_filename(&ps)?),
             diagonal_mm: ps.finite_float("diagonal", 35.0)?,
             iso: ps.finite_float("iso", 100.0)?,
             gbuffer,
@@ -484,6 +484,33 @@ const CAMERA_SENSORS: [&str; 17] = [
     "sony_a7rm3",
     "sony_a9",
 ];
+
+/// The image formats radiant writes, by extension.
+const IMAGE_EXTENSIONS: [&str; 3] = ["exr", "png", "pfm"];
+
+/// `filename` (default "pbrt.exr"), checked here where its location is known: a name
+/// radiant cannot write would otherwise fail only after the render, or without a
+/// place in the scene.
+fn film_filename(ps: &ParamSet) -> Result<String, SceneError> {
+    let name = ps.string("filename", "pbrt.exr".into())?;
+    let Some(p) = ps.lookup("filename") else {
+        return Ok(name);
+    };
+    let ext = std::path::Path::new(&name)
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if name.is_empty() {
+        return Err(SceneError::at(&p.loc, "Film: \"filename\" is empty"));
+    }
+    if !ext.is_some_and(|e| IMAGE_EXTENSIONS.contains(&e.as_str())) {
+        return Err(SceneError::at(
+            &p.loc,
+            format!("Film: cannot write \"{name}\": radiant writes .exr, .png and .pfm images"),
+        ));
+    }
+    Ok(name)
+}
 
 /// `maxcomponentvalue` (default infinite), which must be positive.
 fn film_max_component(ps: &ParamSet) -> Result<f32, SceneError> {
