@@ -204,10 +204,17 @@ fn ply_without_faces_or_with_half_an_attribute_is_reported() {
         std::fs::write(&path, text).unwrap();
         read_ply(&path).unwrap_or_else(|e| panic!("{e}"))
     };
-    let points = read("points.ply", &ascii_ply("x y z", ["0 0 0", "1 0 0", "0 1 0"], ""));
+    let points = read(
+        "points.ply",
+        &ascii_ply("x y z", ["0 0 0", "1 0 0", "0 1 0"], ""),
+    );
     assert!(points.triangles.is_empty());
     assert_eq!(points.notes.len(), 1, "{:?}", points.notes);
-    assert!(points.notes[0].contains("no 'face' element"), "{:?}", points.notes);
+    assert!(
+        points.notes[0].contains("no 'face' element"),
+        "{:?}",
+        points.notes
+    );
 
     let half = read(
         "half.ply",
@@ -220,8 +227,16 @@ fn ply_without_faces_or_with_half_an_attribute_is_reported() {
     assert_eq!(half.triangles, [0, 1, 2]);
     assert!(half.normals.is_none() && half.uvs.is_none());
     assert_eq!(half.notes.len(), 2, "{:?}", half.notes);
-    assert!(half.notes[0].contains("only nx, ny; normals ignored"), "{:?}", half.notes);
-    assert!(half.notes[1].contains("need u and v, but the file has only u"), "{:?}", half.notes);
+    assert!(
+        half.notes[0].contains("only nx, ny; normals ignored"),
+        "{:?}",
+        half.notes
+    );
+    assert!(
+        half.notes[1].contains("need u and v, but the file has only u"),
+        "{:?}",
+        half.notes
+    );
 
     // Each note becomes a warning at the parameter that named the file.
     let scene = format!(
@@ -232,7 +247,8 @@ fn ply_without_faces_or_with_half_an_attribute_is_reported() {
     let w: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
     assert_eq!(w.len(), 1, "{w:?}");
     assert!(
-        w[0].starts_with("t.pbrt:2:17: warning: Shape \"plymesh\": ") && w[0].contains("renders nothing"),
+        w[0].starts_with("t.pbrt:2:17: warning: Shape \"plymesh\": ")
+            && w[0].contains("renders nothing"),
         "{w:?}"
     );
     let _ = std::fs::remove_dir_all(&dir);
@@ -249,9 +265,18 @@ fn ply_data_the_header_does_not_describe_is_an_error() {
         e
     };
     let rows = ["0 0 0", "1 0 0 7", "0 1 0"];
-    let e = err("tokens.ply", ascii_ply("x y z", rows, "3 0 1 2\n").as_bytes());
-    assert!(e.contains("'vertex' 1 has 4 values on its line, but its properties take 3"), "{e}");
-    let e = err("face_tokens.ply", ascii_ply("x y z", ["0 0 0", "1 0 0", "0 1 0"], "3 0 1 2 9\n").as_bytes());
+    let e = err(
+        "tokens.ply",
+        ascii_ply("x y z", rows, "3 0 1 2\n").as_bytes(),
+    );
+    assert!(
+        e.contains("'vertex' 1 has 4 values on its line, but its properties take 3"),
+        "{e}"
+    );
+    let e = err(
+        "face_tokens.ply",
+        ascii_ply("x y z", ["0 0 0", "1 0 0", "0 1 0"], "3 0 1 2 9\n").as_bytes(),
+    );
     assert!(e.contains("'face' 0 has 5 values"), "{e}");
     let ok = ascii_ply("x y z", ["0 0 0", "1 0 0", "0 1 0"], "3 0 1 2\n");
     let e = err("ascii_tail.ply", format!("{ok}\n0 0 1\n").as_bytes());
@@ -274,6 +299,25 @@ fn ply_data_the_header_does_not_describe_is_an_error() {
         e.contains("no vertex index list") && e.contains("'vertex_idx'"),
         "{e}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn obj_errors_name_the_line() {
+    let dir = temp_dir("objline");
+    let path = dir.join("bad.obj");
+    std::fs::write(&path, "# a\nv 0 0 0\nv 1 0 0\nv 1 x 0\nf 1 2 3\n").unwrap();
+    let e = read_obj(&path).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        format!(
+            "{}: error: cannot read OBJ file: line 4: position parse error ('v 1 x 0')",
+            path.display()
+        )
+    );
+    std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 q\n").unwrap();
+    let e = read_obj(&path).unwrap_err().to_string();
+    assert!(e.contains("line 4: face parse error"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
