@@ -250,7 +250,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from(desc.output_name()));
     if args.output.is_none() {
-        check_output(&output)?;
+        // The name came from the scene's Film: say where it was written.
+        check_output(&output)
+            .map_err(|e| anyhow::anyhow!("{}: Film \"filename\": {e:#}", desc.film.loc))?;
     }
     let mut aovs = args.pbrt.aov_set();
     let variance = args.pbrt.wants_variance() || desc.film.gbuffer.is_some();

@@ -8,7 +8,9 @@
 pub mod accel;
 pub mod aov;
 pub mod bench;
-pub mod budget;
+/// The memory budget lives with the scene reader, which checks it for meshes it
+/// generates (loop subdivision) before the renderer sees them.
+pub use radiant_scene::budget;
 pub mod camera;
 pub mod context;
 pub mod geometry;

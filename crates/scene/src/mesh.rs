@@ -19,6 +19,8 @@ pub struct MeshData {
     pub polygons_split: usize,
     /// Faces with fewer than three vertices, dropped.
     pub faces_skipped: usize,
+    /// What the file held that was read but dropped, for warnings.
+    pub notes: Vec<String>,
 }
 
 /// A quad listed around its boundary (v0, v1, v2, v3), as PLY and OBJ list faces, in

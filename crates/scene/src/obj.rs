@@ -18,8 +18,16 @@ pub fn read_obj(path: &Path) -> Result<MeshData, SceneError> {
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _materials) = tobj::load_obj(path, &options)
-        .map_err(|e| SceneError::file(path, format!("cannot read OBJ file: {e}")))?;
+    let (models, _materials) = tobj::load_obj(path, &options).map_err(|e| {
+        let message = match error_line(path, &options, &e) {
+            Some((line, text)) => format!(
+                "cannot read OBJ file: line {line}: {e} ('{}')",
+                crate::token::excerpt(text.trim())
+            ),
+            None => format!("cannot read OBJ file: {e}"),
+        };
+        SceneError::file(path, message)
+    })?;
 
     let all_have = |f: fn(&tobj::Mesh) -> bool| models.iter().all(|m| f(&m.mesh));
     let keep_normals = all_have(|m| m.normals.len() == m.positions.len());
@@ -49,4 +57,46 @@ pub fn read_obj(path: &Path) -> Result<MeshData, SceneError> {
     }
     validate(&mesh).map_err(|m| SceneError::file(path, m))?;
     Ok(mesh)
+}
+
+/// The line where `tobj` met `error`, and its text: `tobj` does not say, so the
+/// shortest prefix of the file that fails the same way is found by bisection (only
+/// on the error path; each try is one parse of a prefix).
+fn error_line(
+    path: &Path,
+    options: &tobj::LoadOptions,
+    error: &tobj::LoadError,
+) -> Option<(usize, String)> {
+    let text = crate::gz::open(path).ok().and_then(|mut f| {
+        let mut s = String::new();
+        std::io::Read::read_to_string(&mut f, &mut s).ok()?;
+        Some(s)
+    })?;
+    let ends: Vec<usize> = text
+        .match_indices('\n')
+        .map(|(i, _)| i + 1)
+        .chain((!text.ends_with('\n')).then_some(text.len()))
+        .collect();
+    let fails = |lines: usize| {
+        let mut prefix = &text.as_bytes()[..ends[lines - 1]];
+        let no_materials = |_: &Path| Ok((Vec::new(), Default::default()));
+        tobj::load_obj_buf(&mut prefix, options, no_materials)
+            .err()
+            .as_ref()
+            == Some(error)
+    };
+    if ends.is_empty() || !fails(ends.len()) {
+        return None;
+    }
+    let (mut lo, mut hi) = (1, ends.len());
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if fails(mid) {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    let start = if lo == 1 { 0 } else { ends[lo - 2] };
+    Some((lo, text[start..ends[lo - 1]].to_string()))
 }

@@ -5,6 +5,8 @@
 //! does not take). Asking for a name that is present with another type is an error.
 
 use std::cell::Cell;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use glam::{Vec2, Vec3};
 
@@ -77,6 +79,10 @@ pub struct Param {
     pub value: ParamValue,
     pub loc: FileLoc,
     used: Cell<bool>,
+    /// For a copy of an `Attribute` default: the flag of the parameter as the
+    /// `Attribute` wrote it, set when any copy is used, so that a default no later
+    /// directive reads can be reported once.
+    origin: Option<Arc<AtomicBool>>,
 }
 
 impl Param {
@@ -86,13 +92,35 @@ impl Param {
             value,
             loc,
             used: Cell::new(false),
+            origin: None,
         }
     }
 
     /// Marks the parameter as used, so that it is never reported (for parameters that
-    /// came from `Attribute` defaults, or that a single "unsupported" warning covers).
+    /// a single "unsupported" warning covers).
     pub fn mark_used(&self) {
         self.used.set(true);
+        if let Some(origin) = &self.origin {
+            origin.store(true, Ordering::Relaxed);
+        }
+    }
+
+    /// Starts tracking the uses of this parameter's copies (see [`Param::inherited`]);
+    /// the flag returned turns true when one of them is used.
+    pub fn track_uses(&mut self) -> Arc<AtomicBool> {
+        let flag = Arc::new(AtomicBool::new(false));
+        self.origin = Some(flag.clone());
+        flag
+    }
+
+    /// A copy for one directive that inherits it as a default: never reported by that
+    /// directive (a default one kind of shape ignores is not worth a warning per
+    /// shape), but its use counts for the original.
+    pub fn inherited(&self) -> Param {
+        Param {
+            used: Cell::new(true),
+            ..self.clone()
+        }
     }
 }
 
@@ -166,7 +194,7 @@ impl ParamSet {
     /// Finds a parameter by name and marks it used.
     pub fn lookup(&self, name: &str) -> Option<&Param> {
         let p = self.params.iter().find(|p| p.name == name)?;
-        p.used.set(true);
+        p.mark_used();
         Some(p)
     }
 

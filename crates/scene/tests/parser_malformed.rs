@@ -164,7 +164,7 @@ const CASES: &[(&str, &str, u32, u32, &[&str])] = &[
         "integer_expected.pbrt",
         1,
         36,
-        &["64.5 is not a 32-bit integer"],
+        &["parameter \"integer xresolution\": 64.5 is not an integer"],
     ),
     (
         "envmap_with_l.pbrt",

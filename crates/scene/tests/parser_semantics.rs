@@ -443,6 +443,64 @@ fn attribute_defaults_apply_to_later_shapes() {
 }
 
 #[test]
+fn attribute_parameters_nobody_reads_are_reported_once() {
+    let s = parse(
+        "WorldBegin\nAttribute \"shape\" \"float bogus1\" [ 1 ]\nAttribute \"light\" \"float bogus2\" 1\n\
+         Attribute \"material\" \"float bogus3\" 1\nAttribute \"shape\" \"float radius\" 2\n\
+         Attribute \"texture\" \"float uscale\" 4 \"float bogus4\" 1\n\
+         Texture \"c\" \"float\" \"checkerboard\"\nLightSource \"point\"\nShape \"sphere\"\nShape \"sphere\"\n",
+    );
+    let msgs: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(
+        msgs,
+        [
+            "t.pbrt:2:19: warning: parameter \"float bogus1\" of Attribute \"shape\" is not used by any later shape",
+            "t.pbrt:3:19: warning: parameter \"float bogus2\" of Attribute \"light\" is not used by any later light",
+            "t.pbrt:4:22: warning: parameter \"float bogus3\" of Attribute \"material\" is not used by any later material",
+            "t.pbrt:6:38: warning: parameter \"float bogus4\" of Attribute \"texture\" is not used by any later texture",
+        ]
+    );
+    let radius = |i: usize| match &s.shapes[i].geometry {
+        Geometry::Sphere { radius, .. } => *radius,
+        g => panic!("{g:?}"),
+    };
+    assert_eq!([radius(0), radius(1)], [2.0, 2.0]);
+}
+
+#[test]
+fn attribute_medium_is_ignored_with_a_warning_and_unknown_targets_refused() {
+    let s = parse("WorldBegin\nAttribute \"medium\" \"float g\" 0.5\n");
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+    assert!(s.warnings[0].message.contains("media are not supported"));
+    let e = err("WorldBegin\nAttribute \"camera\" \"float fov\" 30\n");
+    assert!(
+        e.starts_with("t.pbrt:2:11: error: Attribute: unknown target \"camera\""),
+        "{e}"
+    );
+}
+
+#[test]
+fn accelerators_are_accepted_with_a_warning_and_unknown_ones_refused() {
+    let s = parse(
+        "Accelerator \"bvh\"\nAccelerator \"kdtree\" \"integer maxprims\" 4\n\
+         Accelerator \"bvh\" \"float bogus0\" [ 1 ]\n",
+    );
+    let msgs: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(
+        msgs,
+        [
+            "t.pbrt:2:1: warning: Accelerator \"kdtree\": radiant always builds its own BVH; its parameter \"integer maxprims\" is ignored",
+            "t.pbrt:3:1: warning: Accelerator \"bvh\": radiant always builds its own BVH; its parameter \"float bogus0\" is ignored",
+        ]
+    );
+    let e = err("Accelerator \"octree\" \"float bogus0\" [ 1 ]\n");
+    assert!(
+        e.starts_with("t.pbrt:1:1: error: unknown accelerator \"octree\""),
+        "{e}"
+    );
+}
+
+#[test]
 fn point_and_spot_lights_follow_the_ctm_and_their_power() {
     let s = parse(
         "WorldBegin\nTranslate 0 10 0\n\
@@ -705,6 +763,46 @@ fn a_power_that_is_not_positive_is_ignored_with_a_warning() {
     };
     assert_eq!(cos_falloff_start, 1.0);
     assert_eq!(cos_total_width, 3f32.to_radians().cos());
+}
+
+#[test]
+fn value_errors_name_what_was_written() {
+    for (text, want) in [
+        (
+            "WorldBegin\nShape \"sphere\" \"float radius\" 1 \"float phimax\" [ -10 ]\n",
+            "t.pbrt:2:33: error: \"phimax\" must lie in (0, 360] degrees, got -10",
+        ),
+        (
+            "WorldBegin\nShape \"disk\" \"float phimax\" 0\n",
+            "t.pbrt:2:14: error: \"phimax\" must lie in (0, 360] degrees, got 0",
+        ),
+        (
+            "Film \"rgb\" \"integer xresolution\" [ 1e1 ]\n",
+            "t.pbrt:1:36: error: parameter \"integer xresolution\": an integer must be written without a fraction or exponent",
+        ),
+        (
+            "Film \"rgb\" \"integer xresolution\" 3000000000\n",
+            "t.pbrt:1:34: error: parameter \"integer xresolution\": 3000000000 does not fit a 32-bit integer",
+        ),
+        (
+            "Camera \"realistic\" \"string lensfile\" \".\"\n",
+            "t.pbrt:1:20: error: lens file './.' is a directory, not a file",
+        ),
+        (
+            "WorldBegin\nTexture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \".\"\n",
+            "t.pbrt:2:35: error: image './.' is a directory, not a file",
+        ),
+    ] {
+        assert_eq!(err(text), want, "{text:?}");
+    }
+    let s = parse("WorldBegin\nShape \"sphere\" \"float phimax\" 720\n");
+    assert!(matches!(
+        s.shapes[0].geometry,
+        Geometry::Sphere {
+            phi_max_deg: 360.0,
+            ..
+        }
+    ));
 }
 
 #[test]

@@ -176,6 +176,151 @@ fn bad_ply_data_is_an_error_naming_the_file_and_element() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// An ASCII PLY file: `vertex_props` as the vertex element's properties, `rows` as its
+/// data lines (three vertices), then `faces` as written after a face element header.
+fn ascii_ply(vertex_props: &str, rows: [&str; 3], faces: &str) -> String {
+    let props: String = vertex_props
+        .split_whitespace()
+        .map(|p| format!("property float {p}\n"))
+        .collect();
+    format!(
+        "ply\nformat ascii 1.0\nelement vertex 3\n{props}{faces_header}end_header\n{}\n{}\n{}\n{faces}",
+        rows[0],
+        rows[1],
+        rows[2],
+        faces_header = if faces.is_empty() {
+            ""
+        } else {
+            "element face 1\nproperty list uchar int vertex_indices\n"
+        },
+    )
+}
+
+#[test]
+fn ply_without_faces_or_with_half_an_attribute_is_reported() {
+    let dir = temp_dir("notes");
+    let read = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        read_ply(&path).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let points = read(
+        "points.ply",
+        &ascii_ply("x y z", ["0 0 0", "1 0 0", "0 1 0"], ""),
+    );
+    assert!(points.triangles.is_empty());
+    assert_eq!(points.notes.len(), 1, "{:?}", points.notes);
+    assert!(
+        points.notes[0].contains("no 'face' element"),
+        "{:?}",
+        points.notes
+    );
+
+    let half = read(
+        "half.ply",
+        &ascii_ply(
+            "x y z nx ny u",
+            ["0 0 0 0 0 0", "1 0 0 0 0 1", "0 1 0 0 0 0"],
+            "3 0 1 2\n",
+        ),
+    );
+    assert_eq!(half.triangles, [0, 1, 2]);
+    assert!(half.normals.is_none() && half.uvs.is_none());
+    assert_eq!(half.notes.len(), 2, "{:?}", half.notes);
+    assert!(
+        half.notes[0].contains("only nx, ny; normals ignored"),
+        "{:?}",
+        half.notes
+    );
+    assert!(
+        half.notes[1].contains("need u and v, but the file has only u"),
+        "{:?}",
+        half.notes
+    );
+
+    // Each note becomes a warning at the parameter that named the file.
+    let scene = format!(
+        "WorldBegin\nShape \"plymesh\" \"string filename\" \"{}\"\n",
+        dir.join("points.ply").display()
+    );
+    let s = parse_str(&scene, "t.pbrt", &dir).unwrap_or_else(|e| panic!("{e}"));
+    let w: Vec<String> = s.warnings.iter().map(|w| w.to_string()).collect();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("t.pbrt:2:17: warning: Shape \"plymesh\": ")
+            && w[0].contains("renders nothing"),
+        "{w:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn ply_data_the_header_does_not_describe_is_an_error() {
+    let dir = temp_dir("extra");
+    let err = |name: &str, bytes: &[u8]| {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let e = read_ply(&path).unwrap_err().to_string();
+        assert!(e.starts_with(&path.display().to_string()), "{e}");
+        e
+    };
+    let rows = ["0 0 0", "1 0 0 7", "0 1 0"];
+    let e = err(
+        "tokens.ply",
+        ascii_ply("x y z", rows, "3 0 1 2\n").as_bytes(),
+    );
+    assert!(
+        e.contains("'vertex' 1 has 4 values on its line, but its properties take 3"),
+        "{e}"
+    );
+    let e = err(
+        "face_tokens.ply",
+        ascii_ply("x y z", ["0 0 0", "1 0 0", "0 1 0"], "3 0 1 2 9\n").as_bytes(),
+    );
+    assert!(e.contains("'face' 0 has 5 values"), "{e}");
+    let ok = ascii_ply("x y z", ["0 0 0", "1 0 0", "0 1 0"], "3 0 1 2\n");
+    let e = err("ascii_tail.ply", format!("{ok}\n0 0 1\n").as_bytes());
+    assert!(e.contains("after the last element"), "{e}");
+    // White space after an ASCII file's data is fine.
+    std::fs::write(dir.join("blank_tail.ply"), format!("{ok}\n\n")).unwrap();
+    assert!(read_ply(&dir.join("blank_tail.ply")).is_ok());
+
+    let path = dir.join("bin.ply");
+    write_ply(&path, Encoding::Little, ("u", "v"), &POSITIONS);
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes.extend_from_slice(&[0, 0, 0, 0]);
+    let e = err("bin_tail.ply", &bytes);
+    assert!(e.contains("4 bytes of data after the last element"), "{e}");
+
+    let misnamed = ascii_ply("x y z", ["0 0 0", "1 0 0", "0 1 0"], "3 0 1 2\n")
+        .replace("vertex_indices", "vertex_idx");
+    let e = err("misnamed.ply", misnamed.as_bytes());
+    assert!(
+        e.contains("no vertex index list") && e.contains("'vertex_idx'"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn obj_errors_name_the_line() {
+    let dir = temp_dir("objline");
+    let path = dir.join("bad.obj");
+    std::fs::write(&path, "# a\nv 0 0 0\nv 1 0 0\nv 1 x 0\nf 1 2 3\n").unwrap();
+    let e = read_obj(&path).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        format!(
+            "{}: error: cannot read OBJ file: line 4: position parse error ('v 1 x 0')",
+            path.display()
+        )
+    );
+    std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 q\n").unwrap();
+    let e = read_obj(&path).unwrap_err().to_string();
+    assert!(e.contains("line 4: face parse error"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn obj_meshes_are_triangulated() {
     let dir = temp_dir("obj");

@@ -2,12 +2,22 @@
 //! defaults, object definitions and instances, and the media directives radiant reads
 //! past.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use super::Parser;
 use super::state::{BlockKind, SavedState};
 use crate::desc::ObjectDesc;
 use crate::error::{FileLoc, SceneError};
 use crate::token::{Token, TokenKind};
 use radiant_math::Transform;
+
+/// A parameter given by `Attribute`, with the flag its copies set when used.
+pub(super) struct AttributeParam {
+    what: String,
+    loc: FileLoc,
+    used: Arc<AtomicBool>,
+}
 
 impl Parser {
     pub(super) fn world_begin(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
@@ -69,35 +79,58 @@ impl Parser {
         Ok(())
     }
 
-    /// `Attribute "shape"|"light"|"material"|"medium"|"texture" params`: defaults for
-    /// later directives of that kind in the current block.
+    /// `Attribute "shape"|"light"|"material"|"texture"|"medium" params`: defaults for
+    /// later directives of that kind in the current block (pbrt-v4's five targets).
+    /// Each parameter is tracked, so that one no later directive reads is reported.
     pub(super) fn attribute(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
         let (target, at) = self.string_arg("Attribute")?;
         let ps = self.param_list()?;
-        let list = match target.as_str() {
-            "shape" => &mut self.gs.defaults.shape,
-            "light" => &mut self.gs.defaults.light,
-            "material" => &mut self.gs.defaults.material,
-            "medium" | "texture" => {
+        let (list, readers) = match target.as_str() {
+            "shape" => (&mut self.gs.defaults.shape, "shape"),
+            "light" => (&mut self.gs.defaults.light, "light"),
+            "material" => (&mut self.gs.defaults.material, "material"),
+            "texture" => (&mut self.gs.defaults.texture, "texture"),
+            "medium" => {
                 ps.mark_all_used();
                 self.warn(
                     loc,
-                    format!("Attribute \"{target}\": {target}s are not supported; ignored"),
+                    "Attribute \"medium\": participating media are not supported; ignored",
                 );
                 return Ok(());
             }
             _ => {
                 return Err(SceneError::at(
                     &at,
-                    format!("Attribute: unknown target \"{target}\""),
+                    format!(
+                        "Attribute: unknown target \"{target}\" (expected \"shape\", \"light\", \"material\", \"medium\" or \"texture\")"
+                    ),
                 ));
             }
         };
-        for p in ps.params {
+        for mut p in ps.params {
+            let used = p.track_uses();
+            self.attribute_params.push(AttributeParam {
+                what: format!(
+                    "parameter \"{} {}\" of Attribute \"{target}\" is not used by any later {readers}",
+                    p.value.type_name(),
+                    p.name
+                ),
+                loc: p.loc.clone(),
+                used,
+            });
             list.retain(|q| q.name != p.name);
             list.push(p);
         }
         Ok(())
+    }
+
+    /// Warnings for `Attribute` parameters that no directive read, once each.
+    pub(super) fn report_unused_attributes(&mut self) {
+        for a in std::mem::take(&mut self.attribute_params) {
+            if !a.used.load(Ordering::Relaxed) {
+                self.warn(&a.loc, a.what);
+            }
+        }
     }
 
     pub(super) fn object_begin(&mut self, loc: &FileLoc) -> Result<(), SceneError> {

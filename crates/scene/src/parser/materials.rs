@@ -142,10 +142,10 @@ impl Parser {
             }
             let at = at.clone();
             let filename = self.resolve_path(written);
-            if !filename.is_file() {
+            if let Some(why) = super::not_a_file(&filename) {
                 return Err(SceneError::at(
                     &at,
-                    format!("normal map '{}' not found", filename.display()),
+                    format!("normal map '{}' {why}", filename.display()),
                 ));
             }
             return Ok(Some(ShadingNormalDesc::NormalMap { filename }));

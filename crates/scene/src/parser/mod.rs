@@ -162,6 +162,16 @@ pub(crate) fn read_text(path: &Path) -> Result<String, ReadError> {
     })
 }
 
+/// Why a file the scene names (an image, a lens) cannot be read as a file, or `None`
+/// when it can: a folder is said to be one rather than reported as missing.
+pub(crate) fn not_a_file(path: &Path) -> Option<&'static str> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => Some("is a directory, not a file"),
+        Ok(_) => None,
+        Err(_) => Some("not found"),
+    }
+}
+
 /// One file on the include stack.
 struct Source {
     lexer: Lexer,
@@ -193,6 +203,8 @@ pub(super) struct Parser {
     /// `ObjectInstance` uses, resolved at the end (pbrt allows forward references).
     instance_uses: Vec<(String, Transform, FileLoc)>,
     notes_given: HashSet<&'static str>,
+    /// Every parameter `Attribute` gave, to report those nobody read.
+    attribute_params: Vec<blocks::AttributeParam>,
 
     camera: Option<CameraDesc>,
     film: Option<FilmDesc>,
@@ -237,6 +249,7 @@ impl Parser {
             object_index: HashMap::new(),
             instance_uses: Vec::new(),
             notes_given: HashSet::new(),
+            attribute_params: Vec::new(),
             camera: None,
             film: None,
             sampler: None,
@@ -522,6 +535,7 @@ impl Parser {
                 format!("{} without a matching end", open.kind.begin_name()),
             ));
         }
+        self.report_unused_attributes();
         let mut instances = Vec::with_capacity(self.instance_uses.len());
         for (name, transform, loc) in std::mem::take(&mut self.instance_uses) {
             let Some(&object) = self.object_index.get(&name) else {

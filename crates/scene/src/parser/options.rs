@@ -71,10 +71,10 @@ impl Parser {
                     ));
                 }
                 let lens_file = self.resolve_path(&lens);
-                if !lens_file.is_file() {
+                if let Some(why) = super::not_a_file(&lens_file) {
                     return Err(SceneError::at(
                         &at,
-                        format!("lens file '{}' not found", lens_file.display()),
+                        format!("lens file '{}' {why}", lens_file.display()),
                     ));
                 }
                 if ps.has("aperture") {
@@ -370,11 +370,37 @@ impl Parser {
         Ok(())
     }
 
-    /// `Accelerator`: radiant always builds its own BVH; accepted silently.
+    /// `Accelerator "bvh"|"kdtree"`: radiant always builds its own BVH. The directive
+    /// is accepted (pbrt-v4 scenes name one), but a k-d tree or any parameter is
+    /// ignored with a warning; an unknown type is an error, as it is in pbrt-v4.
     pub(super) fn accelerator(&mut self, loc: &FileLoc) -> Result<(), SceneError> {
-        self.string_arg("Accelerator")?;
-        self.param_list()?.mark_all_used();
-        self.require_options("Accelerator", loc)
+        let (name, _) = self.string_arg("Accelerator")?;
+        let ps = self.param_list()?;
+        self.require_options("Accelerator", loc)?;
+        if name != "bvh" && name != "kdtree" {
+            return Err(SceneError::at(
+                loc,
+                format!("unknown accelerator \"{name}\" (pbrt-v4 has \"bvh\" and \"kdtree\")"),
+            ));
+        }
+        ps.mark_all_used();
+        let params: Vec<String> = ps
+            .params
+            .iter()
+            .map(|p| format!("\"{} {}\"", p.value.type_name(), p.name))
+            .collect();
+        if name == "kdtree" || !params.is_empty() {
+            let ignored = match params.len() {
+                0 => String::new(),
+                1 => format!("; its parameter {} is ignored", params[0]),
+                _ => format!("; its parameters {} are ignored", params.join(", ")),
+            };
+            self.warn(
+                loc,
+                format!("Accelerator \"{name}\": radiant always builds its own BVH{ignored}"),
+            );
+        }
+        Ok(())
     }
 
     pub(super) fn color_space(&mut self, loc: &FileLoc) -> Result<(), SceneError> {

@@ -14,11 +14,15 @@ enum RawValues {
     /// so that large meshes cost 8 bytes per number while they are read).
     Numbers {
         values: Vec<f64>,
-        first_non_int: Option<(f64, FileLoc)>,
+        first_non_int: Option<NonInt>,
     },
     Strings(Vec<(String, FileLoc)>),
     Bools(Vec<bool>),
 }
+
+/// A number that cannot be an `integer` value: its value, where it is, and its
+/// integer literal when it was written as one (then too large for 32 bits).
+type NonInt = (f64, FileLoc, Option<i64>);
 
 /// pbrt type names (v3 spellings included) to the canonical ones.
 fn canonical_type(t: &str) -> Option<&'static str> {
@@ -118,7 +122,7 @@ impl Parser {
                     } => {
                         let is_i32 = integer.is_some_and(|i| i32::try_from(i).is_ok());
                         if !is_i32 && first_non_int.is_none() {
-                            *first_non_int = Some((value, loc));
+                            *first_non_int = Some((value, loc, integer));
                         }
                         values.push(value);
                     }
@@ -189,12 +193,21 @@ fn typed_value(
     Ok(match ty {
         "integer" => match raw {
             RawValues::Numbers {
-                first_non_int: Some((x, at)),
+                first_non_int: Some((x, at, literal)),
                 ..
             } => {
+                let why = match literal {
+                    Some(i) => format!("{i} does not fit a 32-bit integer"),
+                    None if x.fract() != 0.0 || !x.is_finite() => {
+                        format!("{x} is not an integer")
+                    }
+                    // 1e1 or 10.0: an integer value, but not written as one (pbrt-v4
+                    // refuses it too).
+                    None => "an integer must be written without a fraction or exponent".to_string(),
+                };
                 return Err(SceneError::at(
                     &at,
-                    format!("parameter \"{name}\": {x} is not a 32-bit integer"),
+                    format!("parameter \"integer {name}\": {why}"),
                 ));
             }
             // Every value is an integer literal within i32, so the f64 holds it exactly.

@@ -244,6 +244,9 @@ impl Parser {
                 ),
             );
         }
+        for note in std::mem::take(&mut mesh.notes) {
+            self.warn(&at, format!("{owner}: {}: {note}", path.display()));
+        }
         if mesh.faces_skipped > 0 {
             self.warn(
                 &at,
@@ -396,6 +399,11 @@ fn uv_param(ps: &ParamSet, n: usize) -> Result<Option<Vec<Vec2>>, SceneError> {
 /// take tens of gigabytes).
 const MAX_SUBDIVIDED_TRIANGLES: u128 = 1 << 27;
 
+/// Peak memory of `loopsubdiv` per triangle it makes: one triangle subdivided 10 and
+/// 11 times peaks near 270 bytes per triangle for a whole render, of which about 100
+/// are the renderer's BVH.
+const SUBDIVISION_BYTES_PER_TRIANGLE: f64 = 180.0;
+
 fn loop_subdivision(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
     let levels = match ps.ints("levels")? {
         None => 3,
@@ -428,6 +436,17 @@ fn loop_subdivision(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError
             format!(
                 "\"levels\" {levels} would make {count} triangles (at most {MAX_SUBDIVIDED_TRIANGLES})"
             ),
+        ));
+    }
+    // The subdivision's working set (edge maps and vertex rings of the last level) is
+    // far larger than its result, so it is checked against the memory budget before
+    // any of it is made.
+    let bytes = count as f64 * SUBDIVISION_BYTES_PER_TRIANGLE;
+    if let Err(over) = crate::budget::check(bytes) {
+        let at = ps.lookup("levels").map_or(loc, |p| &p.loc).clone();
+        return Err(SceneError::at(
+            &at,
+            format!("\"levels\" {levels} would make {count} triangles, which need {over}"),
         ));
     }
     let s = subdiv::loop_subdivide(&positions, &indices, levels);
@@ -465,8 +484,22 @@ fn sphere(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
         radius,
         z_min: z_min.min(z_max),
         z_max: z_min.max(z_max),
-        phi_max_deg: ps.finite_float("phimax", 360.0)?.clamp(0.0, 360.0),
+        phi_max_deg: phi_max(ps)?,
     })
+}
+
+/// `phimax` in degrees: it must be positive; above 360 it is a full turn (pbrt-v4
+/// clamps it to [0, 360], but a turn of 0 degrees or less has no surface at all).
+fn phi_max(ps: &ParamSet) -> Result<f32, SceneError> {
+    let v = ps.finite_float("phimax", 360.0)?;
+    if v <= 0.0 {
+        let at = &ps.lookup("phimax").expect("present").loc;
+        return Err(SceneError::at(
+            at,
+            format!("\"phimax\" must lie in (0, 360] degrees, got {v}"),
+        ));
+    }
+    Ok(v.min(360.0))
 }
 
 fn disk(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
@@ -474,6 +507,6 @@ fn disk(ps: &ParamSet, loc: &FileLoc) -> Result<Geometry, SceneError> {
         height: ps.finite_float("height", 0.0)?,
         radius: positive(ps, "radius", 1.0, false, loc)?,
         inner_radius: positive(ps, "innerradius", 0.0, true, loc)?,
-        phi_max_deg: ps.finite_float("phimax", 360.0)?.clamp(0.0, 360.0),
+        phi_max_deg: phi_max(ps)?,
     })
 }

@@ -28,6 +28,7 @@ pub(super) struct AttributeDefaults {
     pub shape: Vec<Param>,
     pub light: Vec<Param>,
     pub material: Vec<Param>,
+    pub texture: Vec<Param>,
 }
 
 #[derive(Clone, Debug)]
@@ -83,14 +84,13 @@ pub(super) struct SavedState {
     pub loc: FileLoc,
 }
 
-/// `ps` with the `Attribute` defaults added where it lacks them. Defaults are marked
-/// used: a default that one kind of shape ignores is not worth a warning per shape.
+/// `ps` with the `Attribute` defaults added where it lacks them. The copies are not
+/// reported by the directive; a default that no directive reads is reported once, at
+/// the end of the scene (see `Parser::report_unused_attributes`).
 pub(super) fn with_defaults(mut ps: ParamSet, defaults: &[Param]) -> ParamSet {
     for d in defaults {
         if !ps.has(&d.name) {
-            let p = d.clone();
-            p.mark_used();
-            ps.params.push(p);
+            ps.params.push(d.inherited());
         }
     }
     ps

@@ -20,6 +20,7 @@ use glam::Vec3;
 
 use super::Parser;
 use super::spectrum_param::{SpectrumUse, SpectrumValue};
+use super::state::with_defaults;
 use crate::error::{FileLoc, SceneError};
 use crate::params::{ParamSet, ParamValue};
 use crate::texture::{
@@ -33,7 +34,7 @@ impl Parser {
         let (name, _) = self.string_arg("Texture")?;
         let (ty_name, ty_loc) = self.string_arg("Texture")?;
         let (class, _) = self.string_arg("Texture")?;
-        let ps = self.param_list()?;
+        let ps = with_defaults(self.param_list()?, &self.gs.defaults.texture);
         self.require_world("Texture", loc)?;
         let ty = match ty_name.as_str() {
             "float" => TextureType::Float,
@@ -265,10 +266,10 @@ impl Parser {
         };
         let file_loc = ps.lookup("filename").expect("present").loc.clone();
         let filename = self.resolve_path(&written);
-        if !filename.is_file() {
+        if let Some(why) = super::not_a_file(&filename) {
             return Err(SceneError::at(
                 &file_loc,
-                format!("image '{}' not found", filename.display()),
+                format!("image '{}' {why}", filename.display()),
             ));
         }
         let at = |name: &str| ps.lookup(name).map(|p| p.loc.clone());

@@ -1,5 +1,5 @@
 //! The memory budget: large allocations (the film, radiosity patches and form-factor
-//! matrices) are estimated before they are made and refused, with the parameter that
+//! matrices, subdivided meshes) are estimated before they are made and refused, with the parameter that
 //! asked for them, when the estimate exceeds the budget. Without a budget a request of
 //! 400 GB ends the process with "memory allocation failed" and a backtrace instead of a
 //! message.
