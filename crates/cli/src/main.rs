@@ -107,9 +107,29 @@ fn main() {
         Command::Slurm(args) => slurm_cmd::run(args),
     };
     if let Err(e) = result {
-        eprintln!("radiant: {e:#}");
+        eprintln!("radiant: {}", error_message(&e));
         std::process::exit(1);
     }
+}
+
+/// The error and its causes joined by ": ", as anyhow's `{:#}` joins them, less each
+/// cause whose text its parent's message already holds: a library error that puts its
+/// source in its own message (`#[error("{0}")] Io(#[from] io::Error)`, or
+/// `"{path}: {source}"`) would otherwise say the OS error twice.
+fn error_message(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    let mut parent = String::new();
+    for cause in e.chain() {
+        let message = cause.to_string();
+        if parent.is_empty() || !parent.contains(&message) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&message);
+        }
+        parent = message;
+    }
+    text
 }
 
 /// Standard output could not be written: a reader that stopped reading (a closed pipe)

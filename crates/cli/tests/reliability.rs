@@ -671,3 +671,32 @@ fn a_signal_during_the_form_factors_stops_the_run_at_once() {
     );
     assert_eq!(std::fs::read(&image).unwrap(), before);
 }
+
+/// Library errors that carry an OS error in their own message are not followed by the
+/// same OS error again.
+#[test]
+fn os_errors_are_said_once() {
+    let dir = temp_dir("os-error-once");
+    let at = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let cases = [
+        vec!["merge".into(), at("missing.part"), "-o".into(), at("m.exr")],
+        vec!["lens".into(), at("missing.dat")],
+        vec![
+            "render".into(),
+            "--integrator".into(),
+            "radiosity".into(),
+            "--solution".into(),
+            at("missing.bin"),
+            "--resolution".into(),
+            "2x2".into(),
+            "-o".into(),
+            at("r.exr"),
+        ],
+    ];
+    for args in cases {
+        let out = radiant().args(&args).output().unwrap();
+        let stderr = assert_clean_failure(&out, &args[0]);
+        assert_eq!(stderr.matches("os error 2").count(), 1, "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    }
+}
