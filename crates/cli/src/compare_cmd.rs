@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use radiant::color::Rgb;
 use radiant::image::exr::read_exr_attributes;
 use radiant::image::falsecolor::{ErrorMetric, false_color_error};
@@ -57,6 +57,12 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         )
     };
     let m = compare(&test, &reference, args.crop).with_context(context)?;
+    if m.count == 0 {
+        bail!(
+            "{}: every compared value of the reference is NaN or infinite",
+            args.reference.display()
+        );
+    }
     let flip = if args.flip {
         Some(
             radiant::study::measure(&test, &reference, args.crop, DEFAULT_PIXELS_PER_DEGREE)
@@ -98,6 +104,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
             format!("\"mean_test\": {}", json_number(m.mean_test)),
             format!("\"mean_ref\": {}", json_number(m.mean_ref)),
             format!("\"nonfinite\": {}", m.nonfinite),
+            format!("\"nonfinite_ref\": {}", m.nonfinite_ref),
         ];
         if let Some(s) = diff_scale {
             fields.push(format!("\"diff_scale\": {}", json_number(s as f64)));
@@ -117,6 +124,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
             out!("{name} {}", format_g(v, 6));
         }
         out!("nonfinite {}", m.nonfinite);
+        out!("nonfinite_ref {}", m.nonfinite_ref);
         if let Some(s) = diff_scale {
             out!("diff_scale {}", format_g(s as f64, 6));
         }

@@ -51,6 +51,13 @@ enum Command {
     /// Render a scene (default: the built-in Cornell box).
     Render(render_cmd::RenderArgs),
     /// Error metrics of a render against a reference image (B is the reference).
+    ///
+    /// Prints rmse, relmse (squared error over reference² + 0.01), mae, the two images'
+    /// means, and the non-finite (NaN, ±inf) channel values of each image: `nonfinite`
+    /// in the test image, `nonfinite_ref` in the reference. A non-finite test value
+    /// counts as 0, so a renderer's NaN raises its error (as `compare.py` treats it); a
+    /// non-finite reference value leaves nothing to measure against, so that channel
+    /// value is left out of every figure, for both images.
     Compare(compare_cmd::CompareArgs),
     /// Throughput figures: Mrays/s on the Cornell box and a 1M-triangle mesh, render time.
     Bench(bench_cmd::BenchArgs),
