@@ -45,6 +45,14 @@ pub struct CompareArgs {
 
 /// Runs the comparison and prints the figures.
 pub fn run(args: CompareArgs) -> anyhow::Result<()> {
+    // Output paths are refused before the images are read and measured.
+    if let Some(out) = &args.diff {
+        crate::render_cmd::check_output(out)?;
+    }
+    if let Some(out) = &args.html {
+        radiant::image::atomic::check_writable(out)
+            .with_context(|| format!("cannot write {}", out.display()))?;
+    }
     let test = read_image(&args.test)
         .with_context(|| format!("cannot read test image {}", args.test.display()))?;
     let reference = read_image(&args.reference)

@@ -104,6 +104,15 @@ impl PbrtArgs {
         set
     }
 
+    /// Refuses, before any work, an --mse-reference-out path that cannot be written.
+    pub fn check_outputs(&self) -> anyhow::Result<()> {
+        if let Some(path) = &self.mse_reference_out {
+            radiant::image::atomic::check_writable(path)
+                .with_context(|| format!("cannot write --mse-reference-out {}", path.display()))?;
+        }
+        Ok(())
+    }
+
     /// `--quick` applied to a resolution.
     pub fn quick_resolution(&self, (w, h): (u32, u32)) -> (u32, u32) {
         if self.quick {

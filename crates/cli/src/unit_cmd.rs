@@ -66,6 +66,15 @@ impl UnitArgs {
             || self.partial.is_some()
     }
 
+    /// Refuses, before any work, a --partial path that cannot be written.
+    pub fn check_outputs(&self) -> anyhow::Result<()> {
+        if let Some(path) = &self.partial {
+            radiant::image::atomic::check_writable(path)
+                .with_context(|| format!("cannot write the partial {}", path.display()))?;
+        }
+        Ok(())
+    }
+
     /// Replaces the session's radiosity integrator by the display of a saved solution.
     pub fn load_solution(&self, session: &mut Session, desc: &SceneDesc) -> anyhow::Result<()> {
         let Some(path) = &self.solution else {

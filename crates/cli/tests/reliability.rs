@@ -192,6 +192,84 @@ fn bad_output_paths_fail_before_any_work() {
     assert!(stderr.contains("does not exist"), "{stderr}");
 }
 
+/// Every other output of every subcommand is checked as `-o` is, before the work: the
+/// scene or input named here does not exist, and the error is about the output.
+#[test]
+fn every_output_path_is_checked_before_any_work() {
+    let dir = temp_dir("bad-outputs");
+    let missing = |name: &str| dir.join("missing").join(name);
+    let m = |name: &str| missing(name).to_str().unwrap().to_string();
+    let cases: [(Vec<String>, &str); 6] = [
+        (
+            vec![
+                "render".into(),
+                "no/such/scene.pbrt".into(),
+                "--partial".into(),
+                m("p.part"),
+            ],
+            "cannot write the partial",
+        ),
+        (
+            vec![
+                "render".into(),
+                "no/such/scene.pbrt".into(),
+                "--mse-reference-image".into(),
+                "no/such/ref.exr".into(),
+                "--mse-reference-out".into(),
+                m("mse.txt"),
+            ],
+            "cannot write --mse-reference-out",
+        ),
+        (
+            vec![
+                "radiosity".into(),
+                "no/such/scene.pbrt".into(),
+                "--save-solution".into(),
+                m("s.bin"),
+            ],
+            "cannot write the solution",
+        ),
+        (
+            vec![
+                "lens".into(),
+                "no/such/lens.dat".into(),
+                "--svg".into(),
+                m("x.svg"),
+            ],
+            "x.svg",
+        ),
+        (
+            vec![
+                "compare".into(),
+                "no/such/a.exr".into(),
+                "no/such/b.exr".into(),
+                "--diff".into(),
+                m("d.png"),
+            ],
+            "d.png",
+        ),
+        (
+            vec![
+                "compare".into(),
+                "no/such/a.exr".into(),
+                "no/such/b.exr".into(),
+                "--html".into(),
+                m("r.html"),
+            ],
+            "r.html",
+        ),
+    ];
+    for (args, expect) in cases {
+        let out = radiant().args(&args).output().unwrap();
+        let what = args.join(" ");
+        let stderr = assert_clean_failure(&out, &what);
+        assert!(stderr.contains(expect), "{what}: {stderr}");
+        assert!(stderr.contains("does not exist"), "{what}: {stderr}");
+        assert!(!stderr.contains("no/such/"), "{what}: {stderr}");
+        assert!(out.stdout.is_empty(), "{what}: printed before failing");
+    }
+}
+
 fn spawn(args: &[&str], output: &Path) -> Child {
     radiant()
         .args(args)
