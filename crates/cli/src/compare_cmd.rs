@@ -227,7 +227,8 @@ pub fn format_g(v: f64, digits: usize) -> String {
         };
     }
     if v == 0.0 {
-        return "0".into();
+        // C keeps the sign of zero: "-0".
+        return if v.is_sign_negative() { "-0" } else { "0" }.into();
     }
     let digits = digits.max(1);
     // The exponent after rounding to `digits` significant digits.
@@ -265,5 +266,29 @@ mod tests {
         assert_eq!(format_g(100.0, 6), "100");
         assert_eq!(format_g(-2.5, 6), "-2.5");
         assert_eq!(format_g(0.0, 6), "0");
+    }
+
+    #[test]
+    fn format_g_matches_printf_at_nine_digits() {
+        // pbrt-v4's MSE lines use "%.9g"; expected strings are C's printf output.
+        for (v, c) in [
+            (0.0003969466478, "0.000396946648"),
+            (0.0, "0"),
+            (-0.0, "-0"),
+            (1.0, "1"),
+            (100.0, "100"),
+            (123456789.0, "123456789"),
+            (1234567890.0, "1.23456789e+09"),
+            (123456789012.0, "1.23456789e+11"),
+            (999999999.5, "1e+09"),
+            (1e-05, "1e-05"),
+            (0.0001, "0.0001"),
+            (9.9999999995e-05, "0.0001"),
+            (2.5e-10, "2.5e-10"),
+            (1.0 / 3.0, "0.333333333"),
+            (0.1 + 0.2, "0.3"),
+        ] {
+            assert_eq!(format_g(v, 9), c, "{v:e}");
+        }
     }
 }

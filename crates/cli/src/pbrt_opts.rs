@@ -207,7 +207,8 @@ impl PassWatchers {
         if let Some((reference, out, path)) = &mut self.mse {
             let mse = mean_squared_error(&image, reference);
             // pbrt-v4 writes "%d, %.9g": samples, then the channels' mean MSE.
-            if let Err(e) = writeln!(out, "{spp}, {mse:.9e}").and_then(|_| out.flush()) {
+            let mse = crate::compare_cmd::format_g(mse, 9);
+            if let Err(e) = writeln!(out, "{spp}, {mse}").and_then(|_| out.flush()) {
                 self.errors.push(format!("writing {}: {e}", path.display()));
                 self.mse = None;
             }
