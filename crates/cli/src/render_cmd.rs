@@ -499,10 +499,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .with_context(|| format!("writing {}", output.display()))?;
     }
     times.write = phase.elapsed().as_secs_f64();
-    watchers.finish(&image);
+    let watched = watchers.finish(&image);
     for e in &watchers.errors {
         eprintln!("warning: {e}");
     }
+    watched?;
     if args.pbrt.stats {
         let memory = MemoryUse::of(
             &session,

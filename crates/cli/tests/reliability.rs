@@ -68,7 +68,8 @@ fn previous_render(path: &Path) -> Vec<u8> {
 fn run_with_file_limit(args: &[&str]) -> Output {
     let mut script = String::from("trap '' XFSZ; ulimit -f 8; exec \"$0\"");
     for (i, _) in args.iter().enumerate() {
-        script.push_str(&format!(" \"${}\"", i + 1));
+        // Braced: "$10" would be "$1" followed by "0".
+        script.push_str(&format!(" \"${{{}}}\"", i + 1));
     }
     Command::new("sh")
         .arg("-c")
@@ -135,6 +136,48 @@ fn a_full_disk_keeps_the_previous_gltf_and_its_buffer() {
     assert!(stderr.contains("File too large"), "{stderr}");
     assert_eq!(std::fs::read(&gltf).unwrap(), g0, "previous .gltf changed");
     assert_eq!(std::fs::read(&bin).unwrap(), b0, "previous .bin changed");
+    assert!(temporaries(&dir).is_empty(), "{:?}", temporaries(&dir));
+}
+
+/// An MSE curve that cannot be written (here past a file-size limit, as on a full disk)
+/// fails the render, and the file keeps its last whole version.
+#[test]
+fn an_mse_curve_that_cannot_be_written_fails_the_render() {
+    let dir = temp_dir("mse-full");
+    let reference = dir.join("ref.pfm");
+    let image = dir.join("test.pfm");
+    let mse = dir.join("mse.txt");
+    let tiny = ["--resolution", "2x2", "--quiet", "-o"];
+    let out = radiant()
+        .args(["render", "--spp", "64"])
+        .args(tiny)
+        .arg(&reference)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    // 300 passes of 64 samples: some 6 KB of lines, over the 4 KiB limit.
+    let out = run_with_file_limit(&[
+        "render",
+        "--spp",
+        "19200",
+        "--mse-reference-image",
+        reference.to_str().unwrap(),
+        "--mse-reference-out",
+        mse.to_str().unwrap(),
+        "--resolution",
+        "2x2",
+        "--quiet",
+        "-o",
+        image.to_str().unwrap(),
+    ]);
+    let stderr = assert_clean_failure(&out, "mse curve");
+    assert!(
+        stderr.contains("--mse-reference-out") && stderr.contains("File too large"),
+        "{stderr}"
+    );
+    let text = std::fs::read_to_string(&mse).unwrap();
+    assert!(text.len() > 3000 && text.ends_with('\n'), "{text}");
+    assert!(text.lines().all(|l| l.split_once(", ").is_some()), "{text}");
     assert!(temporaries(&dir).is_empty(), "{:?}", temporaries(&dir));
 }
 
@@ -655,7 +698,8 @@ fn oversized_requests_fail_with_a_located_estimate() {
         all.extend(["--memory-limit", "2G", "-o", out]);
         let mut script = String::from("ulimit -v 4000000; exec \"$0\"");
         for i in 0..all.len() {
-            script.push_str(&format!(" \"${}\"", i + 1));
+            // Braced: "$10" would be "$1" followed by "0".
+            script.push_str(&format!(" \"${{{}}}\"", i + 1));
         }
         let result = Command::new("sh")
             .arg("-c")
