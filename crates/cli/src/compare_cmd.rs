@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use radiant::color::Rgb;
 use radiant::image::exr::read_exr_attributes;
 use radiant::image::falsecolor::{ErrorMetric, false_color_error};
@@ -45,6 +45,14 @@ pub struct CompareArgs {
 
 /// Runs the comparison and prints the figures.
 pub fn run(args: CompareArgs) -> anyhow::Result<()> {
+    // Output paths are refused before the images are read and measured.
+    if let Some(out) = &args.diff {
+        crate::render_cmd::check_output(out)?;
+    }
+    if let Some(out) = &args.html {
+        radiant::image::atomic::check_writable(out)
+            .with_context(|| format!("cannot write {}", out.display()))?;
+    }
     let test = read_image(&args.test)
         .with_context(|| format!("cannot read test image {}", args.test.display()))?;
     let reference = read_image(&args.reference)
@@ -57,6 +65,12 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         )
     };
     let m = compare(&test, &reference, args.crop).with_context(context)?;
+    if m.count == 0 {
+        bail!(
+            "{}: every compared value of the reference is NaN or infinite",
+            args.reference.display()
+        );
+    }
     let flip = if args.flip {
         Some(
             radiant::study::measure(&test, &reference, args.crop, DEFAULT_PIXELS_PER_DEGREE)
@@ -98,6 +112,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
             format!("\"mean_test\": {}", json_number(m.mean_test)),
             format!("\"mean_ref\": {}", json_number(m.mean_ref)),
             format!("\"nonfinite\": {}", m.nonfinite),
+            format!("\"nonfinite_ref\": {}", m.nonfinite_ref),
         ];
         if let Some(s) = diff_scale {
             fields.push(format!("\"diff_scale\": {}", json_number(s as f64)));
@@ -117,6 +132,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
             out!("{name} {}", format_g(v, 6));
         }
         out!("nonfinite {}", m.nonfinite);
+        out!("nonfinite_ref {}", m.nonfinite_ref);
         if let Some(s) = diff_scale {
             out!("diff_scale {}", format_g(s as f64, 6));
         }
@@ -211,7 +227,8 @@ pub fn format_g(v: f64, digits: usize) -> String {
         };
     }
     if v == 0.0 {
-        return "0".into();
+        // C keeps the sign of zero: "-0".
+        return if v.is_sign_negative() { "-0" } else { "0" }.into();
     }
     let digits = digits.max(1);
     // The exponent after rounding to `digits` significant digits.
@@ -249,5 +266,29 @@ mod tests {
         assert_eq!(format_g(100.0, 6), "100");
         assert_eq!(format_g(-2.5, 6), "-2.5");
         assert_eq!(format_g(0.0, 6), "0");
+    }
+
+    #[test]
+    fn format_g_matches_printf_at_nine_digits() {
+        // pbrt-v4's MSE lines use "%.9g"; expected strings are C's printf output.
+        for (v, c) in [
+            (0.0003969466478, "0.000396946648"),
+            (0.0, "0"),
+            (-0.0, "-0"),
+            (1.0, "1"),
+            (100.0, "100"),
+            (123456789.0, "123456789"),
+            (1234567890.0, "1.23456789e+09"),
+            (123456789012.0, "1.23456789e+11"),
+            (999999999.5, "1e+09"),
+            (1e-05, "1e-05"),
+            (0.0001, "0.0001"),
+            (9.9999999995e-05, "0.0001"),
+            (2.5e-10, "2.5e-10"),
+            (1.0 / 3.0, "0.333333333"),
+            (0.1 + 0.2, "0.3"),
+        ] {
+            assert_eq!(format_g(v, 9), c, "{v:e}");
+        }
     }
 }

@@ -52,6 +52,11 @@ fn parse_resolution(text: &str) -> Result<(u32, u32), String> {
 
 /// Runs `radiant lens`.
 pub fn run(args: LensArgs) -> anyhow::Result<()> {
+    // Refused before the report is printed and the rays are timed.
+    if let Some(path) = &args.svg {
+        radiant::image::atomic::check_writable(path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
     let prescription = LensPrescription::from_file(&args.file)?;
     let stop = prescription
         .stop_index()

@@ -51,6 +51,13 @@ enum Command {
     /// Render a scene (default: the built-in Cornell box).
     Render(render_cmd::RenderArgs),
     /// Error metrics of a render against a reference image (B is the reference).
+    ///
+    /// Prints rmse, relmse (squared error over reference² + 0.01), mae, the two images'
+    /// means, and the non-finite (NaN, ±inf) channel values of each image: `nonfinite`
+    /// in the test image, `nonfinite_ref` in the reference. A non-finite test value
+    /// counts as 0, so a renderer's NaN raises its error (as `compare.py` treats it); a
+    /// non-finite reference value leaves nothing to measure against, so that channel
+    /// value is left out of every figure, for both images.
     Compare(compare_cmd::CompareArgs),
     /// Throughput figures: Mrays/s on the Cornell box and a 1M-triangle mesh, render time.
     Bench(bench_cmd::BenchArgs),
@@ -107,9 +114,29 @@ fn main() {
         Command::Slurm(args) => slurm_cmd::run(args),
     };
     if let Err(e) = result {
-        eprintln!("radiant: {e:#}");
+        eprintln!("radiant: {}", error_message(&e));
         std::process::exit(1);
     }
+}
+
+/// The error and its causes joined by ": ", as anyhow's `{:#}` joins them, less each
+/// cause whose text its parent's message already holds: a library error that puts its
+/// source in its own message (`#[error("{0}")] Io(#[from] io::Error)`, or
+/// `"{path}: {source}"`) would otherwise say the OS error twice.
+fn error_message(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    let mut parent = String::new();
+    for cause in e.chain() {
+        let message = cause.to_string();
+        if parent.is_empty() || !parent.contains(&message) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&message);
+        }
+        parent = message;
+    }
+    text
 }
 
 /// Standard output could not be written: a reader that stopped reading (a closed pipe)

@@ -3,7 +3,6 @@
 //! reference, a live view in tev), G-buffer channels and the end-of-render statistics.
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -104,6 +103,15 @@ impl PbrtArgs {
         set
     }
 
+    /// Refuses, before any work, an --mse-reference-out path that cannot be written.
+    pub fn check_outputs(&self) -> anyhow::Result<()> {
+        if let Some(path) = &self.mse_reference_out {
+            radiant::image::atomic::check_writable(path)
+                .with_context(|| format!("cannot write --mse-reference-out {}", path.display()))?;
+        }
+        Ok(())
+    }
+
     /// `--quick` applied to a resolution.
     pub fn quick_resolution(&self, (w, h): (u32, u32)) -> (u32, u32) {
         if self.quick {
@@ -118,10 +126,19 @@ impl PbrtArgs {
 /// long before the image does.
 pub const AOV_SAMPLES: u32 = 64;
 
+/// The `--mse-reference-out` curve: its lines so far, rewritten whole after each pass.
+struct MseCurve {
+    reference: Image,
+    path: PathBuf,
+    text: String,
+}
+
 /// What runs after every pass: partial images, the MSE curve, the live view.
 pub struct PassWatchers {
     partial: Option<(PathBuf, f32)>,
-    mse: Option<(Image, std::io::BufWriter<std::fs::File>, PathBuf)>,
+    mse: Option<MseCurve>,
+    /// Why the MSE curve could not be written: the render fails at its end.
+    mse_failure: Option<String>,
     tev: Option<TevLiveView>,
     verbose: Option<Instant>,
     pub errors: Vec<String>,
@@ -149,9 +166,11 @@ impl PassWatchers {
                         resolution.1
                     );
                 }
-                let file = std::fs::File::create(out)
-                    .with_context(|| format!("--mse-reference-out {}", out.display()))?;
-                Some((image, std::io::BufWriter::new(file), out.clone()))
+                Some(MseCurve {
+                    reference: image,
+                    path: out.clone(),
+                    text: String::new(),
+                })
             }
             _ => None,
         };
@@ -175,6 +194,7 @@ impl PassWatchers {
                 .write_partial_images
                 .then(|| (output.to_path_buf(), exposure)),
             mse,
+            mse_failure: None,
             tev,
             verbose: (args.log_level == LogLevel::Verbose).then(Instant::now),
             errors: Vec::new(),
@@ -195,11 +215,23 @@ impl PassWatchers {
                 start.elapsed().as_secs_f64()
             );
         }
-        if let Some((reference, out, path)) = &mut self.mse {
-            let mse = mean_squared_error(&image, reference);
+        if let Some(curve) = &mut self.mse {
+            let mse = mean_squared_error(&image, &curve.reference);
             // pbrt-v4 writes "%d, %.9g": samples, then the channels' mean MSE.
-            if let Err(e) = writeln!(out, "{spp}, {mse:.9e}").and_then(|_| out.flush()) {
-                self.errors.push(format!("writing {}: {e}", path.display()));
+            let _ = writeln!(
+                curve.text,
+                "{spp}, {}",
+                crate::compare_cmd::format_g(mse, 9)
+            );
+            // The whole curve replaces the file, as every output is written: a reader
+            // sees whole lines, and a failed write leaves the previous curve.
+            if let Err(e) =
+                radiant::image::atomic::atomic_write_bytes(&curve.path, curve.text.as_bytes())
+            {
+                self.mse_failure = Some(format!(
+                    "writing --mse-reference-out {}: {e}",
+                    curve.path.display()
+                ));
                 self.mse = None;
             }
         }
@@ -222,12 +254,17 @@ impl PassWatchers {
         }
     }
 
-    /// The final image to the live view, then closes it.
-    pub fn finish(&mut self, image: &Image) {
+    /// The final image to the live view, then closes it; an MSE curve that could not
+    /// be written is an error (the render is written by then).
+    pub fn finish(&mut self, image: &Image) -> anyhow::Result<()> {
         if let Some(view) = &mut self.tev {
             let pixels: Vec<[f32; 3]> = image.pixels.iter().map(|p| p.to_array()).collect();
             view.update(&pixels);
             view.close();
+        }
+        match self.mse_failure.take() {
+            Some(e) => bail!("{e}"),
+            None => Ok(()),
         }
     }
 }

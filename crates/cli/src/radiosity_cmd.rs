@@ -62,6 +62,10 @@ fn check_outputs(args: &RadiosityArgs) -> anyhow::Result<()> {
         check_writable(path)
             .with_context(|| format!("cannot write the patch table {}", path.display()))?;
     }
+    if let Some(path) = &args.save_solution {
+        check_writable(path)
+            .with_context(|| format!("cannot write the solution {}", path.display()))?;
+    }
     Ok(())
 }
 

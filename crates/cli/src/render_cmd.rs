@@ -183,6 +183,20 @@ pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     }
 }
 
+/// A scene may name pbrt integrators radiant lacks (a warning, then the path tracer);
+/// a name typed on the command line must be one radiant has.
+pub fn check_integrator(name: Option<&str>) -> anyhow::Result<()> {
+    if let Some(name) = name
+        && !INTEGRATOR_NAMES.contains(&name)
+    {
+        bail!(
+            "--integrator {name}: unknown integrator (radiant has: {})",
+            INTEGRATOR_NAMES.join(", ")
+        );
+    }
+    Ok(())
+}
+
 /// Reads a scene file, or builds a canonical scene by name.
 pub fn load_scene(scene: Option<&str>) -> anyhow::Result<SceneDesc> {
     let name = scene.unwrap_or("cornell-box");
@@ -215,21 +229,15 @@ pub fn load_scenes(scene: Option<&str>, more: &[String]) -> anyhow::Result<Scene
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
-    // A scene may name pbrt integrators radiant lacks (a warning, then the path tracer);
-    // a name typed on the command line must be one radiant has.
-    if let Some(name) = &args.integrator
-        && !INTEGRATOR_NAMES.contains(&name.as_str())
-    {
-        bail!(
-            "--integrator {name}: unknown integrator (radiant has: {})",
-            INTEGRATOR_NAMES.join(", ")
-        );
-    }
-    // A path the image cannot be written to is refused before any work.
+    check_integrator(args.integrator.as_deref())?;
+    // A path the image, or any other output, cannot be written to is refused before
+    // any work.
     if let Some(output) = &args.output {
         check_output(output)?;
     }
     args.checkpoint.check()?;
+    args.unit.check_outputs()?;
+    args.pbrt.check_outputs()?;
     let threads = capped_threads(args.threads);
     if let Some(bytes) = args.memory_limit {
         radiant::render::budget::set_limit(bytes);
@@ -493,10 +501,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .with_context(|| format!("writing {}", output.display()))?;
     }
     times.write = phase.elapsed().as_secs_f64();
-    watchers.finish(&image);
+    let watched = watchers.finish(&image);
     for e in &watchers.errors {
         eprintln!("warning: {e}");
     }
+    watched?;
     if args.pbrt.stats {
         let memory = MemoryUse::of(
             &session,

@@ -9,7 +9,10 @@ use std::process::Command;
 use anyhow::{Context, bail};
 use clap::Args;
 
-use crate::unit_cmd::PartBy;
+use radiant::Session;
+use radiant::render::Overrides;
+
+use crate::unit_cmd::{PartBy, UnitArgs};
 
 #[derive(Args, Debug)]
 pub struct SlurmArgs {
@@ -31,8 +34,8 @@ pub struct SlurmArgs {
     #[arg(long)]
     pub integrator: Option<String>,
     /// Image size as WIDTHxHEIGHT.
-    #[arg(long)]
-    pub resolution: Option<String>,
+    #[arg(long, value_parser = crate::render_cmd::parse_resolution)]
+    pub resolution: Option<(u32, u32)>,
     /// A saved radiosity solution to display (with --integrator radiosity).
     #[arg(long, value_name = "FILE")]
     pub solution: Option<PathBuf>,
@@ -41,17 +44,40 @@ pub struct SlurmArgs {
     #[arg(long)]
     pub dir: Option<PathBuf>,
     /// CPUs per task (`--cpus-per-task`); the render uses them all.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     pub cpus: u32,
     /// Slurm partition (`--partition`).
     #[arg(long)]
     pub partition: Option<String>,
-    /// Time limit per task (`--time`, e.g. 01:00:00).
-    #[arg(long)]
+    /// Time limit per task (`--time`): minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM or
+    /// D-HH:MM:SS.
+    #[arg(long, value_parser = parse_time)]
     pub time: Option<String>,
     /// Submit the jobs with sbatch (otherwise only write the scripts).
     #[arg(long)]
     pub submit: bool,
+}
+
+/// Slurm's time formats (`--time`): minutes, minutes:seconds, hours:minutes:seconds,
+/// days-hours, days-hours:minutes, days-hours:minutes:seconds.
+fn parse_time(s: &str) -> Result<String, String> {
+    let number = |t: &str| !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit());
+    let fields = |t: &str, most: usize| {
+        let parts: Vec<&str> = t.split(':').collect();
+        parts.len() <= most && parts.iter().all(|p| number(p))
+    };
+    let ok = match s.split_once('-') {
+        Some((days, rest)) => number(days) && fields(rest, 3),
+        None => fields(s, 3),
+    };
+    if ok {
+        Ok(s.to_string())
+    } else {
+        Err(format!(
+            "\"{}\" is not a Slurm time (minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM or D-HH:MM:SS)",
+            s.escape_debug()
+        ))
+    }
 }
 
 /// `path` absolute (the jobs may start in another folder).
@@ -67,8 +93,97 @@ fn quote(s: &str) -> String {
     format!("'{}'", s.replace('\'', r"'\''"))
 }
 
+/// Double-quoted for an `#SBATCH` line, which sbatch splits at blank space, where an
+/// unquoted `#` starts a comment and a backslash escapes the next character.
+fn sbatch_quote(s: &str) -> String {
+    format!("\"{}\"", s.replace('\\', r"\\").replace('"', "\\\""))
+}
+
+/// `value` as it may go into a job script: UTF-8 (the script is text) without control
+/// characters, which could end a line and start a command of their own.
+fn script_text<'a>(what: &str, value: &'a std::ffi::OsStr) -> anyhow::Result<&'a str> {
+    let Some(text) = value.to_str() else {
+        bail!(
+            "{what} {}: not UTF-8, it cannot go into a job script",
+            value.to_string_lossy()
+        );
+    };
+    if text.chars().any(char::is_control) {
+        bail!(
+            "{what} \"{}\": control characters (a newline, a tab…) cannot go into a job script",
+            text.escape_debug()
+        );
+    }
+    Ok(text)
+}
+
+/// [`script_text`] of a path, as a string.
+fn script_path(what: &str, path: &Path) -> anyhow::Result<String> {
+    script_text(what, path.as_os_str()).map(str::to_string)
+}
+
+/// Folders and files this run made, removed again unless it succeeds (or has queued a
+/// job that will write into them), so a failed run leaves nothing behind.
+#[derive(Default)]
+struct Made {
+    paths: Vec<PathBuf>,
+    keep: bool,
+}
+
+impl Made {
+    /// Creates `dir` and any missing folders above it, noting those it made.
+    fn dir(&mut self, dir: &Path) -> std::io::Result<()> {
+        let mut missing = Vec::new();
+        let mut at = Some(dir);
+        while let Some(d) = at {
+            if d.as_os_str().is_empty() || d.exists() {
+                break;
+            }
+            missing.push(d.to_path_buf());
+            at = d.parent();
+        }
+        for d in missing.into_iter().rev() {
+            std::fs::create_dir(&d)?;
+            self.paths.push(d);
+        }
+        Ok(())
+    }
+
+    /// Writes `path` atomically, noting it if it is new.
+    fn file(&mut self, path: &Path, text: &str) -> anyhow::Result<()> {
+        let new = !path.exists();
+        radiant::image::atomic::atomic_write_bytes(path, text.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+        if new {
+            self.paths.push(path.to_path_buf());
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Made {
+    fn drop(&mut self) {
+        if self.keep {
+            return;
+        }
+        for p in self.paths.iter().rev() {
+            let _ = if p.is_dir() {
+                std::fs::remove_dir(p)
+            } else {
+                std::fs::remove_file(p)
+            };
+        }
+    }
+}
+
 pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
     crate::render_cmd::check_output(&args.output)?;
+    crate::render_cmd::check_integrator(args.integrator.as_deref())?;
+    let partition = args
+        .partition
+        .as_deref()
+        .map(|p| script_text("--partition", p.as_ref()))
+        .transpose()?;
     let output = absolute(&args.output)?;
     let dir = match &args.dir {
         Some(d) => absolute(d)?,
@@ -79,9 +194,10 @@ pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
             output.with_file_name(format!("{stem}.slurm"))
         }
     };
-    std::fs::create_dir_all(dir.join("parts"))
-        .and_then(|_| std::fs::create_dir_all(dir.join("logs")))
-        .with_context(|| format!("creating {}", dir.display()))?;
+    let exe = std::env::current_exe().context("finding the radiant executable")?;
+    let exe = script_path("the radiant executable", &exe)?;
+    let dir_text = script_path("--dir", &dir)?;
+    let output_text = script_path("-o", &output)?;
     let scene = args.scene.clone().unwrap_or_else(|| "cornell-box".into());
     // A file by its absolute path; a canonical scene by its name.
     let scene = if Path::new(&scene).exists() {
@@ -89,9 +205,40 @@ pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
     } else {
         scene
     };
-    // The scene and settings are read and checked here, once, before anything is queued.
-    crate::render_cmd::load_scene(Some(&scene))?;
-    let exe = std::env::current_exe().context("finding the radiant executable")?;
+    script_text("the scene", scene.as_ref())?;
+    let solution = match &args.solution {
+        Some(p) => {
+            let p = absolute(p)?;
+            script_path("--solution", &p)?;
+            Some(p)
+        }
+        None => None,
+    };
+    let n = args.parts;
+
+    // Every task runs `render --part K/N` with these settings: the scene, the settings
+    // and each part are checked here by the code that checks them there, once, before
+    // anything is written or queued.
+    let desc = crate::render_cmd::load_scene(Some(&scene))?;
+    let overrides = Overrides {
+        spp: args.spp,
+        seed: args.seed,
+        resolution: args.resolution,
+        integrator: args.integrator.clone(),
+    };
+    let mut session = Session::new(&desc, &overrides)?;
+    let mut unit = UnitArgs {
+        part_by: args.part_by,
+        solution: solution.clone(),
+        ..Default::default()
+    };
+    unit.load_solution(&mut session, &desc)?;
+    for k in 0..n {
+        unit.part = Some((k, n));
+        unit.unit(&session)
+            .with_context(|| format!("--parts {n}: render --part {k}/{n} would refuse it"))?;
+    }
+
     let mut render = vec!["render".to_string(), scene.clone()];
     let mut push = |flag: &str, v: Option<String>| {
         if let Some(v) = v {
@@ -102,24 +249,22 @@ pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
     push("--spp", args.spp.map(|v| v.to_string()));
     push("--seed", args.seed.map(|v| v.to_string()));
     push("--integrator", args.integrator.clone());
-    push("--resolution", args.resolution.clone());
+    push(
+        "--resolution",
+        args.resolution.map(|(w, h)| format!("{w}x{h}")),
+    );
     push(
         "--solution",
-        args.solution
-            .as_deref()
-            .map(absolute)
-            .transpose()?
-            .map(|p| p.display().to_string()),
+        solution.as_ref().map(|p| p.display().to_string()),
     );
     if args.part_by == PartBy::Samples {
         render.push("--part-by".into());
         render.push("samples".into());
     }
-    let n = args.parts;
     let part_file = |k: u32| dir.join("parts").join(format!("part-{k}.rpart"));
     let mut header = String::from("#!/bin/bash\n");
-    if let Some(p) = &args.partition {
-        let _ = writeln!(header, "#SBATCH --partition={p}");
+    if let Some(p) = partition {
+        let _ = writeln!(header, "#SBATCH --partition={}", sbatch_quote(p));
     }
     if let Some(t) = &args.time {
         let _ = writeln!(header, "#SBATCH --time={t}");
@@ -132,14 +277,14 @@ pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
     let _ = writeln!(
         array,
         "#SBATCH --output={}",
-        dir.join("logs/render-%A_%a.log").display()
+        sbatch_quote(&format!("{dir_text}/logs/render-%A_%a.log"))
     );
     // A preempted or failed task may be run again: its partial is written atomically,
     // so a file that exists is complete, and a rerun replaces it whole.
     let _ = writeln!(array, "#SBATCH --requeue");
     let _ = writeln!(array, "set -euo pipefail");
     let _ = writeln!(array, "K=${{SLURM_ARRAY_TASK_ID}}");
-    let _ = writeln!(array, "DIR={}", quote(&dir.display().to_string()));
+    let _ = writeln!(array, "DIR={}", quote(&dir_text));
     let _ = writeln!(array, "PART=\"$DIR/parts/part-$K.rpart\"");
     let _ = writeln!(
         array,
@@ -148,7 +293,7 @@ pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
     let _ = writeln!(
         array,
         "exec {} {} --threads {} --part \"$K/{n}\" --partial \"$PART\" --quiet",
-        quote(&exe.display().to_string()),
+        quote(&exe),
         quoted.join(" "),
         args.cpus
     );
@@ -157,7 +302,7 @@ pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
     let _ = writeln!(
         merge,
         "#SBATCH --output={}",
-        dir.join("logs/merge-%j.log").display()
+        sbatch_quote(&format!("{dir_text}/logs/merge-%j.log"))
     );
     let _ = writeln!(merge, "set -euo pipefail");
     let parts: Vec<String> = (0..n)
@@ -166,24 +311,29 @@ pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
     let _ = writeln!(
         merge,
         "exec {} merge {} -o {}",
-        quote(&exe.display().to_string()),
+        quote(&exe),
         parts.join(" "),
-        quote(&output.display().to_string())
+        quote(&output_text)
     );
+    let mut made = Made::default();
+    for d in [dir.join("parts"), dir.join("logs")] {
+        made.dir(&d)
+            .with_context(|| format!("creating {}", d.display()))?;
+    }
     let array_path = dir.join("render.sbatch");
     let merge_path = dir.join("merge.sbatch");
     for (path, text) in [(&array_path, &array), (&merge_path, &merge)] {
-        radiant::image::atomic::atomic_write_bytes(path, text.as_bytes())
-            .with_context(|| format!("writing {}", path.display()))?;
+        made.file(path, text)?;
     }
     out!("array job: {}", array_path.display());
     out!("merge job: {}", merge_path.display());
     if !args.submit {
         out!(
             "submit with: id=$(sbatch --parsable {}) && sbatch --dependency=afterok:$id {}",
-            array_path.display(),
-            merge_path.display()
+            quote(&format!("{dir_text}/render.sbatch")),
+            quote(&format!("{dir_text}/merge.sbatch"))
         );
+        made.keep = true;
         return Ok(());
     }
     let sbatch = |extra: &[String], script: &Path| -> anyhow::Result<String> {
@@ -205,7 +355,50 @@ pub fn run(args: SlurmArgs) -> anyhow::Result<()> {
         Ok(text.trim().split(';').next().unwrap_or("").to_string())
     };
     let array_id = sbatch(&[], &array_path)?;
+    // Its tasks write into the folders now.
+    made.keep = true;
     let merge_id = sbatch(&[format!("--dependency=afterok:{array_id}")], &merge_path)?;
     out!("submitted array job {array_id} ({n} tasks), merge job {merge_id}");
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{parse_time, sbatch_quote};
+
+    #[test]
+    fn times_take_slurms_formats_only() {
+        for ok in [
+            "90",
+            "0",
+            "10:30",
+            "01:00:00",
+            "2-12",
+            "2-12:30",
+            "2-12:30:15",
+        ] {
+            assert_eq!(parse_time(ok).as_deref(), Ok(ok));
+        }
+        for bad in [
+            "",
+            "1h",
+            "1:2:3:4",
+            "-5",
+            "2-",
+            "2-1:2:3:4",
+            "1::2",
+            "1:00\n",
+            "1 0",
+            "1-2-3",
+            "$(reboot)",
+        ] {
+            assert!(parse_time(bad).is_err(), "{bad:?}");
+        }
+    }
+
+    #[test]
+    fn sbatch_values_are_one_quoted_word() {
+        assert_eq!(sbatch_quote("a b"), r#""a b""#);
+        assert_eq!(sbatch_quote(r##"a"#b\"##), r##""a\"#b\\""##);
+    }
 }

@@ -77,6 +77,9 @@ pub fn run(args: StudyArgs) -> anyhow::Result<()> {
         .with_context(|| format!("cannot write the report {}", args.output.display()))?;
     if let Some(dir) = &args.save_images {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        let probe = dir.join("reference.exr");
+        radiant::image::atomic::check_writable(&probe)
+            .with_context(|| format!("cannot write the images into {}", dir.display()))?;
     }
     let budget = match (args.equal_time, args.equal_spp) {
         (Some(s), _) => Budget::Seconds(s),

@@ -66,6 +66,15 @@ impl UnitArgs {
             || self.partial.is_some()
     }
 
+    /// Refuses, before any work, a --partial path that cannot be written.
+    pub fn check_outputs(&self) -> anyhow::Result<()> {
+        if let Some(path) = &self.partial {
+            radiant::image::atomic::check_writable(path)
+                .with_context(|| format!("cannot write the partial {}", path.display()))?;
+        }
+        Ok(())
+    }
+
     /// Replaces the session's radiosity integrator by the display of a saved solution.
     pub fn load_solution(&self, session: &mut Session, desc: &SceneDesc) -> anyhow::Result<()> {
         let Some(path) = &self.solution else {
@@ -98,6 +107,14 @@ impl UnitArgs {
 
     /// Sets the session's work unit from the flags, checked against the render.
     pub fn apply(&self, session: &mut Session) -> anyhow::Result<WorkUnit> {
+        let unit = self.unit(session)?;
+        session.ctx.work = unit;
+        Ok(unit)
+    }
+
+    /// The work unit the flags select, refused where the session's render cannot take
+    /// it (`radiant slurm` checks every part of its job with this before writing it).
+    pub fn unit(&self, session: &Session) -> anyhow::Result<WorkUnit> {
         let ctx = &session.ctx;
         let (resolution, spp) = (ctx.resolution, ctx.spp);
         let mut unit = WorkUnit::full(resolution, spp);
@@ -137,7 +154,6 @@ impl UnitArgs {
                 session.integrator.name()
             );
         }
-        session.ctx.work = unit;
         Ok(unit)
     }
 

@@ -151,3 +151,43 @@ fn a_closed_standard_output_is_not_a_panic() {
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
 }
+
+/// NaN in either image is counted in that image's own figure, and the metrics stay
+/// finite: a test NaN counts as 0, a reference NaN is left out.
+#[test]
+fn non_finite_values_are_counted_in_each_image() {
+    use radiant::color::Rgb;
+    use radiant::image::{Image, ImageMeta, write_image};
+    let dir = std::env::temp_dir().join(format!("radiant-compare-nan-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut clean = Image::new(2, 2);
+    clean.pixels.fill(Rgb::splat(0.5));
+    let mut nan = clean.clone();
+    nan.set(1, 1, Rgb::splat(f32::NAN));
+    let (a, b) = (dir.join("clean.pfm"), dir.join("nan.pfm"));
+    write_image(&a, &clean, &ImageMeta::default(), 0.0).unwrap();
+    write_image(&b, &nan, &ImageMeta::default(), 0.0).unwrap();
+    let (a, b) = (a.to_str().unwrap(), b.to_str().unwrap());
+
+    // The reference has the NaN pixel: left out, so the rest matches exactly.
+    let (ok, stdout, stderr) = radiant(&["compare", a, b]);
+    assert!(ok, "{stderr}");
+    assert_eq!(figure(&stdout, "nonfinite"), 0.0, "{stdout}");
+    assert_eq!(figure(&stdout, "nonfinite_ref"), 3.0, "{stdout}");
+    assert_eq!(figure(&stdout, "rmse"), 0.0, "{stdout}");
+    assert_eq!(figure(&stdout, "mean_ref"), 0.5, "{stdout}");
+
+    // The test has it: counted as 0 against the reference's 0.5.
+    let (ok, stdout, stderr) = radiant(&["compare", b, a, "--json"]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.contains("\"nonfinite\": 3") && stdout.contains("\"nonfinite_ref\": 0"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("\"rmse\": 0.25"), "{stdout}");
+
+    // A reference with nothing finite to compare against is an error.
+    let (ok, _, stderr) = radiant(&["compare", a, b, "--crop", "1,1,2,2"]);
+    assert!(!ok && stderr.contains("NaN or infinite"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}

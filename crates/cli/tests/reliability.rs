@@ -68,7 +68,8 @@ fn previous_render(path: &Path) -> Vec<u8> {
 fn run_with_file_limit(args: &[&str]) -> Output {
     let mut script = String::from("trap '' XFSZ; ulimit -f 8; exec \"$0\"");
     for (i, _) in args.iter().enumerate() {
-        script.push_str(&format!(" \"${}\"", i + 1));
+        // Braced: "$10" would be "$1" followed by "0".
+        script.push_str(&format!(" \"${{{}}}\"", i + 1));
     }
     Command::new("sh")
         .arg("-c")
@@ -138,6 +139,48 @@ fn a_full_disk_keeps_the_previous_gltf_and_its_buffer() {
     assert!(temporaries(&dir).is_empty(), "{:?}", temporaries(&dir));
 }
 
+/// An MSE curve that cannot be written (here past a file-size limit, as on a full disk)
+/// fails the render, and the file keeps its last whole version.
+#[test]
+fn an_mse_curve_that_cannot_be_written_fails_the_render() {
+    let dir = temp_dir("mse-full");
+    let reference = dir.join("ref.pfm");
+    let image = dir.join("test.pfm");
+    let mse = dir.join("mse.txt");
+    let tiny = ["--resolution", "2x2", "--quiet", "-o"];
+    let out = radiant()
+        .args(["render", "--spp", "64"])
+        .args(tiny)
+        .arg(&reference)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    // 300 passes of 64 samples: some 6 KB of lines, over the 4 KiB limit.
+    let out = run_with_file_limit(&[
+        "render",
+        "--spp",
+        "19200",
+        "--mse-reference-image",
+        reference.to_str().unwrap(),
+        "--mse-reference-out",
+        mse.to_str().unwrap(),
+        "--resolution",
+        "2x2",
+        "--quiet",
+        "-o",
+        image.to_str().unwrap(),
+    ]);
+    let stderr = assert_clean_failure(&out, "mse curve");
+    assert!(
+        stderr.contains("--mse-reference-out") && stderr.contains("File too large"),
+        "{stderr}"
+    );
+    let text = std::fs::read_to_string(&mse).unwrap();
+    assert!(text.len() > 3000 && text.ends_with('\n'), "{text}");
+    assert!(text.lines().all(|l| l.split_once(", ").is_some()), "{text}");
+    assert!(temporaries(&dir).is_empty(), "{:?}", temporaries(&dir));
+}
+
 /// Output paths that cannot be written are refused before the scene is even read: the
 /// scene named here does not exist, and the error is about the output.
 #[test]
@@ -190,6 +233,84 @@ fn bad_output_paths_fail_before_any_work() {
         .unwrap();
     let stderr = assert_clean_failure(&out, "radiosity patches folder");
     assert!(stderr.contains("does not exist"), "{stderr}");
+}
+
+/// Every other output of every subcommand is checked as `-o` is, before the work: the
+/// scene or input named here does not exist, and the error is about the output.
+#[test]
+fn every_output_path_is_checked_before_any_work() {
+    let dir = temp_dir("bad-outputs");
+    let missing = |name: &str| dir.join("missing").join(name);
+    let m = |name: &str| missing(name).to_str().unwrap().to_string();
+    let cases: [(Vec<String>, &str); 6] = [
+        (
+            vec![
+                "render".into(),
+                "no/such/scene.pbrt".into(),
+                "--partial".into(),
+                m("p.part"),
+            ],
+            "cannot write the partial",
+        ),
+        (
+            vec![
+                "render".into(),
+                "no/such/scene.pbrt".into(),
+                "--mse-reference-image".into(),
+                "no/such/ref.exr".into(),
+                "--mse-reference-out".into(),
+                m("mse.txt"),
+            ],
+            "cannot write --mse-reference-out",
+        ),
+        (
+            vec![
+                "radiosity".into(),
+                "no/such/scene.pbrt".into(),
+                "--save-solution".into(),
+                m("s.bin"),
+            ],
+            "cannot write the solution",
+        ),
+        (
+            vec![
+                "lens".into(),
+                "no/such/lens.dat".into(),
+                "--svg".into(),
+                m("x.svg"),
+            ],
+            "x.svg",
+        ),
+        (
+            vec![
+                "compare".into(),
+                "no/such/a.exr".into(),
+                "no/such/b.exr".into(),
+                "--diff".into(),
+                m("d.png"),
+            ],
+            "d.png",
+        ),
+        (
+            vec![
+                "compare".into(),
+                "no/such/a.exr".into(),
+                "no/such/b.exr".into(),
+                "--html".into(),
+                m("r.html"),
+            ],
+            "r.html",
+        ),
+    ];
+    for (args, expect) in cases {
+        let out = radiant().args(&args).output().unwrap();
+        let what = args.join(" ");
+        let stderr = assert_clean_failure(&out, &what);
+        assert!(stderr.contains(expect), "{what}: {stderr}");
+        assert!(stderr.contains("does not exist"), "{what}: {stderr}");
+        assert!(!stderr.contains("no/such/"), "{what}: {stderr}");
+        assert!(out.stdout.is_empty(), "{what}: printed before failing");
+    }
 }
 
 fn spawn(args: &[&str], output: &Path) -> Child {
@@ -577,7 +698,8 @@ fn oversized_requests_fail_with_a_located_estimate() {
         all.extend(["--memory-limit", "2G", "-o", out]);
         let mut script = String::from("ulimit -v 4000000; exec \"$0\"");
         for i in 0..all.len() {
-            script.push_str(&format!(" \"${}\"", i + 1));
+            // Braced: "$10" would be "$1" followed by "0".
+            script.push_str(&format!(" \"${{{}}}\"", i + 1));
         }
         let result = Command::new("sh")
             .arg("-c")
@@ -670,4 +792,33 @@ fn a_signal_during_the_form_factors_stops_the_run_at_once() {
         "{latency:?} from the signal to the exit"
     );
     assert_eq!(std::fs::read(&image).unwrap(), before);
+}
+
+/// Library errors that carry an OS error in their own message are not followed by the
+/// same OS error again.
+#[test]
+fn os_errors_are_said_once() {
+    let dir = temp_dir("os-error-once");
+    let at = |name: &str| dir.join(name).to_str().unwrap().to_string();
+    let cases = [
+        vec!["merge".into(), at("missing.part"), "-o".into(), at("m.exr")],
+        vec!["lens".into(), at("missing.dat")],
+        vec![
+            "render".into(),
+            "--integrator".into(),
+            "radiosity".into(),
+            "--solution".into(),
+            at("missing.bin"),
+            "--resolution".into(),
+            "2x2".into(),
+            "-o".into(),
+            at("r.exr"),
+        ],
+    ];
+    for args in cases {
+        let out = radiant().args(&args).output().unwrap();
+        let stderr = assert_clean_failure(&out, &args[0]);
+        assert_eq!(stderr.matches("os error 2").count(), 1, "{stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    }
 }

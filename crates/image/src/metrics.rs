@@ -9,8 +9,11 @@
 //! - `mae    = mean(|a-b|)`
 //! - `mean_test`, `mean_ref` as a brightness sanity check.
 //!
-//! Non-finite test values (NaN, ±inf) are counted per channel value and replaced by 0
-//! before everything else; the reference is used as it is. Sums are taken in f64.
+//! Non-finite values (NaN, ±inf) are counted per channel value, in each image apart.
+//! A non-finite test value is replaced by 0 before everything else (as `compare.py`
+//! does: a renderer's NaN counts against it). A non-finite reference value leaves
+//! nothing to measure against: that channel value is left out of every figure, for
+//! both images, and `count` says how many were compared. Sums are taken in f64.
 
 use super::{Crop, Image, ImageError};
 
@@ -27,7 +30,10 @@ pub struct Metrics {
     pub mean_ref: f64,
     /// Number of non-finite channel values in the test image (each replaced by 0).
     pub nonfinite: usize,
-    /// Number of channel values compared (3 × pixels in the crop).
+    /// Number of non-finite channel values in the reference (each left out).
+    pub nonfinite_ref: usize,
+    /// Number of channel values compared (3 × pixels in the crop, less those with a
+    /// non-finite reference).
     pub count: usize,
 }
 
@@ -51,7 +57,7 @@ pub fn compare(test: &Image, reference: &Image, crop: Option<Crop>) -> Result<Me
     crop.check(test.width, test.height)?;
 
     let (mut se, mut rel, mut ae, mut st, mut sr) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
-    let mut nonfinite = 0usize;
+    let (mut nonfinite, mut nonfinite_ref) = (0usize, 0usize);
     for y in crop.y0..crop.y1 {
         let row = y * test.width;
         let t_row = &test.pixels[row + crop.x0..row + crop.x1];
@@ -64,6 +70,10 @@ pub fn compare(test: &Image, reference: &Image, crop: Option<Crop>) -> Result<Me
                     a = 0.0;
                 }
                 let b = r[c] as f64;
+                if !b.is_finite() {
+                    nonfinite_ref += 1;
+                    continue;
+                }
                 let d = a - b;
                 se += d * d;
                 rel += d * d / (b * b + RELMSE_EPSILON);
@@ -73,7 +83,7 @@ pub fn compare(test: &Image, reference: &Image, crop: Option<Crop>) -> Result<Me
             }
         }
     }
-    let count = 3 * crop.width() * crop.height();
+    let count = 3 * crop.width() * crop.height() - nonfinite_ref;
     let n = count as f64;
     Ok(Metrics {
         rmse: (se / n).sqrt(),
@@ -82,6 +92,7 @@ pub fn compare(test: &Image, reference: &Image, crop: Option<Crop>) -> Result<Me
         mean_test: st / n,
         mean_ref: sr / n,
         nonfinite,
+        nonfinite_ref,
         count,
     })
 }
@@ -121,6 +132,25 @@ mod tests {
         assert!(close(m.mean_ref, 4.1 / 6.0), "{m:?}");
         assert_eq!(m.nonfinite, 1);
         assert_eq!(m.count, 6);
+    }
+
+    #[test]
+    fn non_finite_values_are_counted_in_each_image_and_a_bad_reference_is_left_out() {
+        // test: (1,2,NaN) (4,5,6); ref: (1,1,1) (inf,NaN,6)
+        // Left out: the reference's inf and NaN (G and R of pixel 2).
+        // Compared: d = 0, 1, -1 (the test's NaN becomes 0), 0 → 4 values.
+        let t = image(2, 1, &[[1.0, 2.0, f32::NAN], [4.0, 5.0, 6.0]]);
+        let r = image(2, 1, &[[1.0, 1.0, 1.0], [f32::INFINITY, f32::NAN, 6.0]]);
+        let m = compare(&t, &r, None).unwrap();
+        assert_eq!((m.nonfinite, m.nonfinite_ref, m.count), (1, 2, 4));
+        assert!((m.rmse - (2.0f64 / 4.0).sqrt()).abs() < 1e-12, "{m:?}");
+        assert!((m.mae - 0.5).abs() < 1e-12, "{m:?}");
+        assert!((m.mean_test - 9.0 / 4.0).abs() < 1e-12, "{m:?}");
+        assert!((m.mean_ref - 9.0 / 4.0).abs() < 1e-12, "{m:?}");
+        // Swapped, each count follows its image.
+        let m = compare(&r, &t, None).unwrap();
+        assert_eq!((m.nonfinite, m.nonfinite_ref, m.count), (2, 1, 5));
+        assert!(m.rmse.is_finite() && m.relmse.is_finite(), "{m:?}");
     }
 
     #[test]
