@@ -722,15 +722,32 @@ fn oversized_requests_fail_with_a_located_estimate() {
 #[test]
 fn geometry_over_the_budget_fails_at_the_shape() {
     let dir = temp_dir("geometry-budget");
-    // 8 · 4^5 = 8192 triangles: about 0.8 MB by the estimate.
+    // A 64 × 64 grid of quads, 8192 triangles: about 0.8 MB by the estimate. (Loop
+    // subdivision, which would make as many from a few lines, checks its own working
+    // set while the scene is read.)
+    let n = 64;
+    let points: Vec<String> = (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| format!("{i} {j} 0")))
+        .collect();
+    let indices: Vec<String> = (0..n)
+        .flat_map(|j| {
+            (0..n).map(move |i| {
+                let a = j * (n + 1) + i;
+                let (b, c, d) = (a + 1, a + n + 1, a + n + 2);
+                format!("{a} {b} {d} {a} {d} {c}")
+            })
+        })
+        .collect();
     let scene = write_scene(
         &dir,
         "mesh.pbrt",
         &format!(
             "{CAMERA}WorldBegin\nLightSource \"point\" \"point3 from\" [0 0 5]\n\
              Shape \"sphere\"\n\
-             Shape \"loopsubdiv\" \"integer levels\" 5 \"point3 P\" [1 0 0 -1 0 0 0 1 0 0 -1 0 0 0 1 0 0 -1]\n\
-             \"integer indices\" [0 2 4 2 1 4 1 3 4 3 0 4 2 0 5 1 2 5 3 1 5 0 3 5]\n"
+             Shape \"trianglemesh\" \"point3 P\" [{}]\n\
+             \"integer indices\" [{}]\n",
+            points.join(" "),
+            indices.join(" ")
         ),
     );
     let out = dir.join("out.exr");
