@@ -587,9 +587,10 @@ fn aovs_channel_count(set: radiant::render::aov::AovSet) -> usize {
 
 /// Checks that `path` names an image format and that its folder takes a new file.
 pub fn check_output(path: &Path) -> anyhow::Result<()> {
+    // The image error names the path already.
     radiant::image::check_output(path)
         .map(|_| ())
-        .with_context(|| format!("cannot write the output image {}", path.display()))
+        .context("cannot write the output image")
 }
 
 /// More worker threads than this many per core only add scheduling overhead.
