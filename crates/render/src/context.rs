@@ -215,7 +215,7 @@ impl RenderContext {
             filter,
             sampler: desc.sampler.kind,
             seed: overrides.seed.unwrap_or(desc.sampler.seed),
-            sensor: Sensor::new(desc.film.iso, 1.0)
+            sensor: Sensor::new(desc.film.iso, desc.camera.exposure_time)
                 .with_max_component(desc.film.max_component_value)
                 .with_white_balance(desc.film.white_balance),
             resolution,

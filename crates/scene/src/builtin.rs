@@ -98,6 +98,7 @@ pub fn right_handed_camera(
             focal_distance: 1e6,
             screen_window: None,
         },
+        exposure_time: 1.0,
         loc: loc(scene),
     }
 }

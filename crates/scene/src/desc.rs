@@ -53,6 +53,9 @@ pub struct CameraDesc {
     /// The current transform at the `Camera` directive.
     pub camera_from_world: Transform,
     pub kind: CameraKind,
+    /// `shutterclose` − `shutteropen` (default 1 s): the exposure time of the sensor's
+    /// imaging ratio, as in pbrt-v4.
+    pub exposure_time: f32,
     pub loc: FileLoc,
 }
 

@@ -727,6 +727,21 @@ fn out_of_range_light_camera_and_film_values_are_errors_at_the_parameter() {
     }
 }
 
+/// The exposure time is the shutter interval (pbrt-v4's imaging ratio); a shutter that
+/// never opens is an error at the camera, as in pbrt-v4.
+#[test]
+fn the_camera_shutter_sets_the_exposure_time() {
+    assert_eq!(parse("Camera \"perspective\"\n").camera.exposure_time, 1.0);
+    let s = parse("Camera \"perspective\" \"float shutteropen\" 0.5 \"float shutterclose\" 0.75\n");
+    assert_eq!(s.camera.exposure_time, 0.25);
+    assert!(s.warnings.is_empty(), "{:#?}", s.warnings);
+    let e = err("Camera \"orthographic\" \"float shutteropen\" 1 \"float shutterclose\" 1\n");
+    assert!(
+        e.starts_with("t.pbrt:1:1:") && e.contains("the shutter never opens"),
+        "{e}"
+    );
+}
+
 /// pbrt-v4 ignores a `power` or `illuminance` that is not positive; radiant does too,
 /// and says so where the value is written.
 #[test]

@@ -560,6 +560,7 @@ impl Parser {
                     focal_distance: 1e6,
                     screen_window: None,
                 },
+                exposure_time: 1.0,
                 loc: loc.clone(),
             }),
             film: self.film.unwrap_or_else(|| FilmDesc {

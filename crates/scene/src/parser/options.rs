@@ -102,10 +102,21 @@ impl Parser {
             }
             _ => return Err(SceneError::at(loc, format!("unknown camera \"{name}\""))),
         };
+        let exposure_time =
+            ps.finite_float("shutterclose", 1.0)? - ps.finite_float("shutteropen", 0.0)?;
+        if exposure_time.is_nan() || exposure_time <= 0.0 {
+            return Err(SceneError::at(
+                loc,
+                format!(
+                    "Camera: the shutter never opens (\"shutterclose\" − \"shutteropen\" = {exposure_time} s); the image would be black"
+                ),
+            ));
+        }
         self.report_unused(&ps, &format!("Camera \"{name}\""));
         self.camera = Some(CameraDesc {
             camera_from_world,
             kind,
+            exposure_time,
             loc: loc.clone(),
         });
         Ok(())
