@@ -25,7 +25,25 @@ pub enum Filter {
     Gaussian {
         radius: Vec2,
         sigma: f32,
-        tables: Box<[GaussianAxis; 2]>,
+        tables: Box<[TabulatedAxis; 2]>,
+    },
+    /// Mitchell & Netravali's cubic ("Reconstruction Filters in Computer Graphics",
+    /// SIGGRAPH 1988) with parameters `b` and `c`, its support [-2, 2] stretched over the
+    /// radius as pbrt-v4 does, the product over both axes. Negative lobes: see
+    /// [`FilterSample::weight`].
+    Mitchell {
+        radius: Vec2,
+        b: f32,
+        c: f32,
+        tables: Box<[TabulatedAxis; 2]>,
+    },
+    /// Lanczos' windowed sinc, sinc(x) · sinc(x / τ) truncated at the radius (Turkowski,
+    /// "Filters for Common Resampling Tasks", Graphics Gems 1990), per axis; pbrt-v4's
+    /// `"sinc"`.
+    LanczosSinc {
+        radius: Vec2,
+        tau: f32,
+        tables: Box<[TabulatedAxis; 2]>,
     },
 }
 
@@ -37,6 +55,9 @@ pub struct FilterSample {
     /// f(offset) / (pdf(offset) · ∫f), with expectation 1: exactly 1 for box and
     /// triangle; for the Gaussian, whose pdf is a tabulated approximation of f, within
     /// 1.4e-3 of 1 per axis (measured; 1.5e-5 for |offset| < 1 at the default σ 0.5).
+    /// Filters with negative lobes (Mitchell, Lanczos) are sampled by |f|, so an offset in
+    /// a negative lobe has a negative weight, about −∫|f| / ∫f; the film's weighted mean
+    /// then rings as the filter does, as in pbrt-v4.
     pub weight: f32,
 }
 
@@ -66,8 +87,8 @@ impl Filter {
         let radius = Vec2::new(fix(radius.x, 1.5), fix(radius.y, 1.5));
         let sigma = fix(sigma, 0.5);
         let tables = Box::new([
-            GaussianAxis::new(radius.x, sigma),
-            GaussianAxis::new(radius.y, sigma),
+            TabulatedAxis::new(radius.x, Profile::gaussian(radius.x, sigma)),
+            TabulatedAxis::new(radius.y, Profile::gaussian(radius.y, sigma)),
         ]);
         Filter::Gaussian {
             radius,
@@ -76,12 +97,83 @@ impl Filter {
         }
     }
 
+    /// Mitchell & Netravali's filter (see the variant); pbrt-v4's defaults are radius 2
+    /// and b = c = 1/3. Non-positive or non-finite radii, and non-finite b or c, are
+    /// replaced by those defaults.
+    pub fn mitchell(radius: Vec2, b: f32, c: f32) -> Filter {
+        let fix = |v: f32| if v.is_finite() && v > 0.0 { v } else { 2.0 };
+        let radius = Vec2::new(fix(radius.x), fix(radius.y));
+        let third = |v: f32| if v.is_finite() { v } else { 1.0 / 3.0 };
+        let (b, c) = (third(b), third(c));
+        let tables = Box::new([
+            TabulatedAxis::new(
+                radius.x,
+                Profile::Mitchell {
+                    b,
+                    c,
+                    scale: 2.0 / radius.x,
+                },
+            ),
+            TabulatedAxis::new(
+                radius.y,
+                Profile::Mitchell {
+                    b,
+                    c,
+                    scale: 2.0 / radius.y,
+                },
+            ),
+        ]);
+        Filter::Mitchell {
+            radius,
+            b,
+            c,
+            tables,
+        }
+    }
+
+    /// Lanczos' windowed sinc (see the variant); pbrt-v4's defaults are radius 4 and
+    /// τ = 3, which replace non-positive or non-finite values.
+    pub fn lanczos_sinc(radius: Vec2, tau: f32) -> Filter {
+        let fix = |v: f32, default: f32| if v.is_finite() && v > 0.0 { v } else { default };
+        let radius = Vec2::new(fix(radius.x, 4.0), fix(radius.y, 4.0));
+        let tau = fix(tau, 3.0);
+        let tables = Box::new([
+            TabulatedAxis::new(radius.x, Profile::LanczosSinc { tau }),
+            TabulatedAxis::new(radius.y, Profile::LanczosSinc { tau }),
+        ]);
+        Filter::LanczosSinc {
+            radius,
+            tau,
+            tables,
+        }
+    }
+
+    /// The per-axis tables of the tabulated filters.
+    fn tables(&self) -> Option<&[TabulatedAxis; 2]> {
+        match self {
+            Filter::Box { .. } | Filter::Triangle { .. } => None,
+            Filter::Gaussian { tables, .. }
+            | Filter::Mitchell { tables, .. }
+            | Filter::LanczosSinc { tables, .. } => Some(tables),
+        }
+    }
+
+    /// ∫ |eval| over the plane: the normalisation of the density offsets are drawn with.
+    pub fn abs_integral(&self) -> f32 {
+        match self.tables() {
+            Some([x, y]) => (x.abs_integral * y.abs_integral) as f32,
+            None => self.integral(),
+        }
+    }
+
     /// Half-width of the filter's support along each axis.
     pub fn radius(&self) -> Vec2 {
         match self {
             Filter::Box { radius }
             | Filter::Triangle { radius }
-            | Filter::Gaussian { radius, .. } => *radius,
+            | Filter::Gaussian { radius, .. }
+            | Filter::Mitchell { radius, .. }
+            | Filter::LanczosSinc { radius, .. } => *radius,
         }
     }
 
@@ -98,7 +190,9 @@ impl Filter {
             Filter::Triangle { radius } => {
                 (radius.x - p.x.abs()).max(0.0) * (radius.y - p.y.abs()).max(0.0)
             }
-            Filter::Gaussian { tables, .. } => tables[0].eval(p.x) * tables[1].eval(p.y),
+            Filter::Gaussian { tables, .. }
+            | Filter::Mitchell { tables, .. }
+            | Filter::LanczosSinc { tables, .. } => tables[0].eval(p.x) * tables[1].eval(p.y),
         }
     }
 
@@ -107,12 +201,16 @@ impl Filter {
         match self {
             Filter::Box { radius } => 4.0 * radius.x * radius.y,
             Filter::Triangle { radius } => radius.x * radius.x * radius.y * radius.y,
-            Filter::Gaussian { tables, .. } => (tables[0].integral * tables[1].integral) as f32,
+            Filter::Gaussian { tables, .. }
+            | Filter::Mitchell { tables, .. }
+            | Filter::LanczosSinc { tables, .. } => {
+                (tables[0].integral * tables[1].integral) as f32
+            }
         }
     }
 
-    /// Draws an offset with density ∝ the filter (approximately, for the Gaussian) from
-    /// `u` in [0,1)².
+    /// Draws an offset with density ∝ |filter| (approximately, for the tabulated ones)
+    /// from `u` in [0,1)².
     pub fn sample(&self, u: Vec2) -> FilterSample {
         match self {
             Filter::Box { radius } => FilterSample {
@@ -123,7 +221,9 @@ impl Filter {
                 offset: Vec2::new(sample_tent(u.x) * radius.x, sample_tent(u.y) * radius.y),
                 weight: 1.0,
             },
-            Filter::Gaussian { tables, .. } => {
+            Filter::Gaussian { tables, .. }
+            | Filter::Mitchell { tables, .. }
+            | Filter::LanczosSinc { tables, .. } => {
                 let (x, wx) = tables[0].sample(u.x);
                 let (y, wy) = tables[1].sample(u.y);
                 FilterSample {
@@ -145,95 +245,163 @@ fn sample_tent(u: f32) -> f32 {
     }
 }
 
-/// Segments of the tabulated per-axis Gaussian density (a power of two; see `sample`).
-const GAUSSIAN_SEGMENTS: usize = 1024;
+/// Segments of each tabulated per-axis density (a power of two; see `sample`).
+const TABLE_SEGMENTS: usize = 1024;
 
-/// One axis of the Gaussian filter, sampled by inverting a piecewise-*linear*
-/// interpolant of g on a uniform grid over [-r, r]. The interpolant tracks g closely (also
-/// near ±r, where g reaches 0 with non-zero slope), so the weight g(x) / interpolant(x)
-/// stays within ~1.4e-3 of 1 (worst in the last grid cell, where the relative
-/// interpolation error is g''·h / (2|g'|)) instead of swinging near the edges as a
-/// piecewise-constant table's would.
+/// The one-dimensional profile of a separable tabulated filter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Profile {
+    /// exp(−x²/(2σ²)) − exp(−r²/(2σ²)), at least 0.
+    Gaussian { inv_two_sigma2: f32, offset: f32 },
+    /// The Mitchell–Netravali cubic at `scale · x`.
+    Mitchell { b: f32, c: f32, scale: f32 },
+    /// sinc(x) · sinc(x / τ).
+    LanczosSinc { tau: f32 },
+}
+
+impl Profile {
+    fn gaussian(radius: f32, sigma: f32) -> Profile {
+        let inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
+        Profile::Gaussian {
+            inv_two_sigma2,
+            offset: (-radius * radius * inv_two_sigma2).exp(),
+        }
+    }
+
+    /// The profile at `x`, ignoring the support.
+    fn at(&self, x: f32) -> f32 {
+        match *self {
+            Profile::Gaussian {
+                inv_two_sigma2,
+                offset,
+            } => ((-x * x * inv_two_sigma2).exp() - offset).max(0.0),
+            Profile::Mitchell { b, c, scale } => {
+                // Mitchell & Netravali's piecewise cubic on |x| ≤ 1 and 1 < |x| ≤ 2.
+                let x = (scale * x).abs();
+                if x <= 1.0 {
+                    ((12.0 - 9.0 * b - 6.0 * c) * x * x * x
+                        + (-18.0 + 12.0 * b + 6.0 * c) * x * x
+                        + (6.0 - 2.0 * b))
+                        / 6.0
+                } else if x <= 2.0 {
+                    ((-b - 6.0 * c) * x * x * x
+                        + (6.0 * b + 30.0 * c) * x * x
+                        + (-12.0 * b - 48.0 * c) * x
+                        + (8.0 * b + 24.0 * c))
+                        / 6.0
+                } else {
+                    0.0
+                }
+            }
+            Profile::LanczosSinc { tau } => sinc(x) * sinc(x / tau),
+        }
+    }
+}
+
+/// sin(πx) / (πx), 1 at 0.
+fn sinc(x: f32) -> f32 {
+    let px = std::f32::consts::PI * x;
+    if px.abs() < 1e-5 { 1.0 } else { px.sin() / px }
+}
+
+/// One axis of a tabulated filter, sampled by inverting a piecewise-*linear*
+/// interpolant of |f| on a uniform grid over [-r, r]. The interpolant tracks |f| closely
+/// (also near ±r, where the Gaussian reaches 0 with non-zero slope), so the weight
+/// f(x) / interpolant(x) stays within ~1.4e-3 of ±1 for the Gaussian (worst in the last
+/// grid cell, where the relative interpolation error is f''·h / (2|f'|)) instead of
+/// swinging near the edges as a piecewise-constant table's would.
 #[derive(Clone, Debug, PartialEq)]
-pub struct GaussianAxis {
+pub struct TabulatedAxis {
     radius: f32,
-    /// 1 / (2σ²)
-    inv_two_sigma2: f32,
-    /// exp(-r²/(2σ²)), subtracted so that g(±r) = 0.
-    offset: f32,
-    /// g at the grid nodes x_i = -r + i·h, i = 0..=N.
+    profile: Profile,
+    /// |f| at the grid nodes x_i = -r + i·h, i = 0..=N.
     node_values: Vec<f32>,
     /// Cumulative trapezoid areas, `cdf[0] = 0`, unnormalised (total = cdf[N]).
     cdf: Vec<f64>,
     /// `guide[k]` = the last segment i with `cdf[i] <= k/N · total`: sampling starts there
     /// and scans forward a step or two instead of binary-searching the whole CDF.
     guide: Vec<u32>,
-    /// ∫ g over [-r, r] (composite Simpson, f64).
+    /// ∫ f over [-r, r] (composite Simpson, f64).
     integral: f64,
+    /// ∫ |f| over [-r, r], the same way.
+    abs_integral: f64,
 }
 
-impl GaussianAxis {
-    fn new(radius: f32, sigma: f32) -> GaussianAxis {
-        let inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
-        let offset = (-radius * radius * inv_two_sigma2).exp();
-        let mut axis = GaussianAxis {
+impl TabulatedAxis {
+    fn new(radius: f32, profile: Profile) -> TabulatedAxis {
+        let mut axis = TabulatedAxis {
             radius,
-            inv_two_sigma2,
-            offset,
-            node_values: Vec::with_capacity(GAUSSIAN_SEGMENTS + 1),
-            cdf: Vec::with_capacity(GAUSSIAN_SEGMENTS + 1),
-            guide: Vec::with_capacity(GAUSSIAN_SEGMENTS),
+            profile,
+            node_values: Vec::with_capacity(TABLE_SEGMENTS + 1),
+            cdf: Vec::with_capacity(TABLE_SEGMENTS + 1),
+            guide: Vec::with_capacity(TABLE_SEGMENTS),
             integral: 0.0,
+            abs_integral: 0.0,
         };
-        let h = 2.0 * radius / GAUSSIAN_SEGMENTS as f32;
-        for i in 0..=GAUSSIAN_SEGMENTS {
-            let v = axis.eval(-radius + i as f32 * h);
+        let h = 2.0 * radius / TABLE_SEGMENTS as f32;
+        for i in 0..=TABLE_SEGMENTS {
+            let v = axis.eval(-radius + i as f32 * h).abs();
             axis.node_values.push(v);
         }
-        axis.node_values[0] = 0.0;
-        axis.node_values[GAUSSIAN_SEGMENTS] = 0.0;
+        // The end nodes take the profile's value at the rim from inside: 0 for the
+        // Gaussian, not for a sinc truncated between its zeros, whose weights would
+        // otherwise grow without bound towards the rim.
+        let rim = profile.at(radius).abs();
+        axis.node_values[0] = rim;
+        axis.node_values[TABLE_SEGMENTS] = rim;
         let mut acc = 0.0f64;
         axis.cdf.push(0.0);
         for w in axis.node_values.windows(2) {
             acc += 0.5 * h as f64 * (w[0] as f64 + w[1] as f64);
             axis.cdf.push(acc);
         }
-        // Simpson on 8N intervals: error ~ (h/8)^4, far below f32 precision.
-        let n = 8 * GAUSSIAN_SEGMENTS;
+        // Simpson on 8N intervals: error ~ (h/8)^4, far below f32 precision where f is
+        // smooth (|f| has kinks at a sign change, where the rule is first-order there).
+        let n = 8 * TABLE_SEGMENTS;
         let hs = 2.0 * radius as f64 / n as f64;
-        let g = |x: f64| ((-x * x * inv_two_sigma2 as f64).exp() - offset as f64).max(0.0);
-        let mut s = g(-radius as f64) + g(radius as f64);
-        for i in 1..n {
-            s += g(-radius as f64 + i as f64 * hs) * if i % 2 == 1 { 4.0 } else { 2.0 };
+        let f = |x: f64| profile.at(x as f32) as f64;
+        let (mut s, mut s_abs) = (0.0, 0.0);
+        for i in 0..=n {
+            let w = if i == 0 || i == n {
+                1.0
+            } else if i % 2 == 1 {
+                4.0
+            } else {
+                2.0
+            };
+            let v = f(-radius as f64 + i as f64 * hs);
+            s += w * v;
+            s_abs += w * v.abs();
         }
         axis.integral = s * hs / 3.0;
+        axis.abs_integral = s_abs * hs / 3.0;
         let total = acc;
-        for k in 0..GAUSSIAN_SEGMENTS {
-            let level = k as f64 / GAUSSIAN_SEGMENTS as f64 * total;
+        for k in 0..TABLE_SEGMENTS {
+            let level = k as f64 / TABLE_SEGMENTS as f64 * total;
             let i = axis.cdf.partition_point(|&c| c <= level).saturating_sub(1);
-            axis.guide.push(i.min(GAUSSIAN_SEGMENTS - 1) as u32);
+            axis.guide.push(i.min(TABLE_SEGMENTS - 1) as u32);
         }
         axis
     }
 
-    /// g(x), zero outside [-r, r].
+    /// f(x), zero outside [-r, r].
     fn eval(&self, x: f32) -> f32 {
         if x.abs() >= self.radius {
             return 0.0;
         }
-        ((-x * x * self.inv_two_sigma2).exp() - self.offset).max(0.0)
+        self.profile.at(x)
     }
 
-    /// Returns (x, g(x) / interpolant(x)).
+    /// Returns (x, f(x) / interpolant(x), normalised so that its expectation is 1).
     fn sample(&self, u: f32) -> (f32, f32) {
-        let total = self.cdf[GAUSSIAN_SEGMENTS];
+        let total = self.cdf[TABLE_SEGMENTS];
         let u = u.clamp(0.0, 1.0) as f64;
         let target = u * total;
         // Last segment i with cdf[i] <= target. N is a power of two, so k/N·total <= target
         // holds exactly for k = floor(u·N) and the guide never starts past the answer.
-        let k = ((u * GAUSSIAN_SEGMENTS as f64) as usize).min(GAUSSIAN_SEGMENTS - 1);
+        let k = ((u * TABLE_SEGMENTS as f64) as usize).min(TABLE_SEGMENTS - 1);
         let mut i = self.guide[k] as usize;
-        while i + 1 < GAUSSIAN_SEGMENTS && self.cdf[i + 1] <= target {
+        while i + 1 < TABLE_SEGMENTS && self.cdf[i + 1] <= target {
             i += 1;
         }
         let area = self.cdf[i + 1] - self.cdf[i];
@@ -251,14 +419,15 @@ impl GaussianAxis {
         } else {
             local
         };
-        let h = 2.0 * self.radius as f64 / GAUSSIAN_SEGMENTS as f64;
+        let h = 2.0 * self.radius as f64 / TABLE_SEGMENTS as f64;
         let x = (-(self.radius as f64) + (i as f64 + t) * h) as f32;
         let interpolant = a + (b - a) * t;
         let weight = if interpolant > 0.0 {
-            // Normalise by ∫g / ∫interpolant so that E[weight] = 1 exactly.
+            // Normalise by ∫f / ∫interpolant so that E[weight] = 1 exactly.
             (self.eval(x) as f64 / interpolant * total / self.integral) as f32
         } else {
-            // Only at x = ±r (u = 0 or 1), where g/interpolant → 1 in the limit.
+            // Only where |f| vanishes on a whole cell's ends (the Gaussian's rim, u = 0
+            // or 1), where f / interpolant → 1 in the limit.
             1.0
         };
         (x, weight)
@@ -345,7 +514,7 @@ mod tests {
             unreachable!()
         };
         let axis = &tables[0];
-        let total = axis.cdf[GAUSSIAN_SEGMENTS];
+        let total = axis.cdf[TABLE_SEGMENTS];
         let mut rng = Pcg32::new(5, 5);
         for j in 0..20_000 {
             let u = if j < 2 {
@@ -358,8 +527,8 @@ mod tests {
                 .cdf
                 .partition_point(|&c| c <= target)
                 .saturating_sub(1)
-                .min(GAUSSIAN_SEGMENTS - 1);
-            let h = 2.0 * axis.radius as f64 / GAUSSIAN_SEGMENTS as f64;
+                .min(TABLE_SEGMENTS - 1);
+            let h = 2.0 * axis.radius as f64 / TABLE_SEGMENTS as f64;
             let x = axis.sample(u).0 as f64 + axis.radius as f64;
             // The sample lies in segment i (up to f32 rounding of x).
             assert!(

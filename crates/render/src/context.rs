@@ -207,6 +207,8 @@ impl RenderContext {
             FilterKind::Box => Filter::box_filter(desc.filter.radius),
             FilterKind::Triangle => Filter::triangle(desc.filter.radius),
             FilterKind::Gaussian { sigma } => Filter::gaussian(desc.filter.radius, sigma),
+            FilterKind::Mitchell { b, c } => Filter::mitchell(desc.filter.radius, b, c),
+            FilterKind::LanczosSinc { tau } => Filter::lanczos_sinc(desc.filter.radius, tau),
         };
         let spp = spp.max(1);
         let context = RenderContext {

@@ -162,6 +162,15 @@ pub enum FilterKind {
     Gaussian {
         sigma: f32,
     },
+    /// Mitchell & Netravali's cubic with parameters `b` and `c` (pbrt-v4's `B`, `C`).
+    Mitchell {
+        b: f32,
+        c: f32,
+    },
+    /// pbrt-v4's `"sinc"`: Lanczos' windowed sinc with window `tau`.
+    LanczosSinc {
+        tau: f32,
+    },
 }
 
 /// `PixelFilter`: kind and radius in pixels.

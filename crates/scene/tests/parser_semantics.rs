@@ -603,7 +603,7 @@ fn area_lights_scale_and_power() {
 #[test]
 fn unsupported_things_warn_once_each_and_parse_on() {
     let s = parse(
-        "Sampler \"pmj02bn\"\nPixelFilter \"mitchell\" \"float B\" 0.3\nFilm \"spectral\"\nAccelerator \"bvh\"\n\
+        "Sampler \"pmj02bn\"\nPixelFilter \"lanczos\" \"float tau\" 3\nFilm \"spectral\"\nAccelerator \"bvh\"\n\
          Option \"bool disablepixeljitter\" true\nWorldBegin\nTexture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" 4\n\
          MakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\n\
          Shape \"curve\" \"point3 P\" [ 0 0 0 1 1 1 2 2 2 3 3 3 ]\nLightSource \"goniometric\"\n\
@@ -725,6 +725,32 @@ fn out_of_range_light_camera_and_film_values_are_errors_at_the_parameter() {
             "{text:?}: expected {at} … {words}, got {e}"
         );
     }
+}
+
+/// pbrt-v4's Mitchell and sinc filters, with their default radii and parameters.
+#[test]
+fn mitchell_and_sinc_filters_follow_pbrt_v4() {
+    let s = parse("PixelFilter \"mitchell\"\n");
+    assert_eq!(
+        s.filter.kind,
+        FilterKind::Mitchell {
+            b: 1.0 / 3.0,
+            c: 1.0 / 3.0
+        }
+    );
+    assert_eq!(s.filter.radius, glam::Vec2::splat(2.0));
+    let s = parse("PixelFilter \"mitchell\" \"float B\" 0 \"float C\" 0.5 \"float xradius\" 1.5\n");
+    assert_eq!(s.filter.kind, FilterKind::Mitchell { b: 0.0, c: 0.5 });
+    assert_eq!(s.filter.radius, glam::Vec2::new(1.5, 2.0));
+    let s = parse("PixelFilter \"sinc\"\n");
+    assert_eq!(s.filter.kind, FilterKind::LanczosSinc { tau: 3.0 });
+    assert_eq!(s.filter.radius, glam::Vec2::splat(4.0));
+    assert!(s.warnings.is_empty(), "{:#?}", s.warnings);
+    let e = err("PixelFilter \"sinc\" \"float tau\" 0\n");
+    assert!(
+        e.starts_with("t.pbrt:1:20:") && e.contains("\"tau\" must be positive"),
+        "{e}"
+    );
 }
 
 /// The exposure time is the shutter interval (pbrt-v4's imaging ratio); a shutter that

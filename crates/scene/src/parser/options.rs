@@ -335,6 +335,19 @@ impl Parser {
                 },
                 1.5,
             ),
+            "mitchell" => (
+                FilterKind::Mitchell {
+                    b: ps.finite_float("B", 1.0 / 3.0)?,
+                    c: ps.finite_float("C", 1.0 / 3.0)?,
+                },
+                2.0,
+            ),
+            "sinc" => (
+                FilterKind::LanczosSinc {
+                    tau: ps.float_where("tau", 3.0, "must be positive", |t| t > 0.0)?,
+                },
+                4.0,
+            ),
             _ => {
                 ps.mark_all_used();
                 self.warn(loc, format!("PixelFilter \"{name}\" is not supported; using a gaussian filter (sigma 0.5, radius 1.5)"));
