@@ -2,8 +2,8 @@
 //! by Pearson's chi-square test (`radiant_testkit::chi2`): every filter's offsets must
 //! follow |f| / ∫|f| over the rectangle of its support, and the weights must be right —
 //! f / (pdf ∫f) per sample (so the density they imply is the sampler's), with mean
-//! 1. Filters with negative lobes (Mitchell, Lanczos) are sampled by |f| and carry the
-//! sign in their weights.
+//! one. Filters with negative lobes (Mitchell, Lanczos) are sampled by |f| and carry
+//! the sign in their weights.
 
 use radiant_image::Filter;
 use radiant_math::Vec2;
