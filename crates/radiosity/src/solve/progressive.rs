@@ -200,6 +200,24 @@ pub struct ProgressiveReport {
     pub converged: bool,
     /// The progress hook asked to stop before convergence.
     pub stopped: bool,
+    /// Shots whose factors had to be scaled to closure.
+    pub closure: ClosureReport,
+}
+
+/// Row sums of form factors up to this far above 1 are rounding or quadrature noise
+/// (a closed enclosure's rows sum to 1 to rounding with the contour factors) and are
+/// left alone.
+pub const CLOSURE_SLACK: f64 = 1e-3;
+
+/// Shooter rows whose factors summed to more than 1 and were scaled back to 1.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ClosureReport {
+    /// Shots whose row sum exceeded `1 + CLOSURE_SLACK`.
+    pub scaled_rows: usize,
+    /// The largest row sum seen (0 when none was scaled).
+    pub largest_row_sum: f64,
+    /// Shots with a non-finite factor (set to 0).
+    pub non_finite: usize,
 }
 
 /// Receivers per parallel work item. Fixed (not derived from the thread count) so that
@@ -312,6 +330,8 @@ pub fn solve_progressive_start<V: Visibility>(
         },
         shot_cull: ShotCull::default(),
         cull: matches!(factors, ShootingFactors::RayCast(_)) && !vis.always_visible(),
+        coefficients: Vec::new(),
+        closure: ClosureReport::default(),
     };
     let fraction = |state: &ProgressiveState| match settings.selection {
         ShooterSelection::TotalPower => state.unshot_fraction(),
@@ -367,6 +387,7 @@ pub fn solve_progressive_start<V: Visibility>(
         unshot_fraction_per_band: fractions_per_band,
         converged,
         stopped,
+        closure: shooting.closure,
     })
 }
 
@@ -381,6 +402,9 @@ struct Shooting<'a, V: Visibility> {
     /// Occluders that matter per group of receivers for the current shooter.
     shot_cull: ShotCull,
     cull: bool,
+    /// Scratch: the shot's gathering coefficients `F_ji`.
+    coefficients: Vec<f64>,
+    closure: ClosureReport,
 }
 
 impl<V: Visibility> Shooting<'_, V> {
@@ -412,6 +436,40 @@ impl<V: Visibility> Shooting<'_, V> {
                 ShootingFactors::Matrix(m) => m.get(i, j) * area_i / set.patches[j].area,
             }
         };
+        self.coefficients.resize(set.len(), 0.0);
+        self.coefficients
+            .par_iter_mut()
+            .enumerate()
+            .with_min_len(64)
+            .for_each(|(j, c)| *c = coefficient(j));
+        // Closure of the shooter's row: by reciprocity `sum_j A_j F_ji = A_i sum_j F_ij`,
+        // and the factors from one side of a patch cannot sum to more than 1 (Cohen &
+        // Wallace, "Radiosity and Realistic Image Synthesis", sec. 4.1). Estimates that
+        // do (e.g. rays that slip past a surface lying on the receiver) would hand out
+        // more power than the shot carries and make the iteration diverge, so such a row
+        // is scaled back to 1 and counted.
+        let row_sum = self
+            .coefficients
+            .iter()
+            .zip(&set.patches)
+            .map(|(c, p)| c * p.area)
+            .sum::<f64>()
+            / area_i;
+        if !row_sum.is_finite() {
+            self.closure.non_finite += 1;
+            self.coefficients.iter_mut().for_each(|c| {
+                if !c.is_finite() {
+                    *c = 0.0;
+                }
+            });
+        } else if row_sum > 1.0 + CLOSURE_SLACK {
+            self.closure.scaled_rows += 1;
+            self.closure.largest_row_sum = self.closure.largest_row_sum.max(row_sum);
+            let scale = 1.0 / row_sum;
+            self.coefficients.iter_mut().for_each(|c| *c *= scale);
+        }
+        let coefficients = &self.coefficients;
+        let coefficient = |j: usize| coefficients[j];
         let partials: Vec<ShotPartial> = state
             .radiosity
             .par_chunks_mut(CHUNK)

@@ -6,6 +6,7 @@
 //! - [`shaft`]: shaft culling, the few occluders that matter per progressive shot.
 
 pub mod bvh;
+pub mod contact;
 pub mod shaft;
 
 use glam::DVec3;
