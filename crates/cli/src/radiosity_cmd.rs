@@ -284,7 +284,7 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
     };
     // The context first: its world reads the light-sampler parameter.
     let (ctx, w) = RenderContext::new(&desc, &overrides)?;
-    let settings = RadiositySettings::from_desc(&desc.integrator)?;
+    let settings = RadiositySettings::for_scene(&desc.integrator, &desc)?;
     for w in desc
         .integrator
         .params
