@@ -463,7 +463,11 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         );
     }
     out!("{}", solution.balance.summary());
-    if let Some(warning) = solution.balance.escape_warning() {
+    if let Some(warning) = solution
+        .balance
+        .escape_warning()
+        .filter(|_| !solution.interrupted)
+    {
         eprintln!("warning: {warning}");
     }
     // Rows a little above 1 are the centroid estimate's error next to much smaller

@@ -431,9 +431,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     {
         bail!("{failure}; no image written");
     }
+    // Interrupted solves have not distributed their light yet: no escape warning.
     if let Some(warning) = output_data
         .stats
         .get::<radiant::radiosity::solve::RadiosityStats>()
+        .filter(|_| !output_data.interrupted)
         .and_then(|s| s.balance.escape_warning())
     {
         eprintln!("warning: {warning}");

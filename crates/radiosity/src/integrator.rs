@@ -170,11 +170,15 @@ pub fn solve_session_resumed(
         resume,
         |event| {
             let done = match event {
-                SolveEvent::Shot { fraction_done, .. } => (1000.0 * fraction_done) as u64,
-                SolveEvent::Factors { done, total } => (900 * done / total.max(1)) as u64,
-                SolveEvent::Sweep { .. } => 900,
+                SolveEvent::Shot { fraction_done, .. } => Some((1000.0 * fraction_done) as u64),
+                SolveEvent::Factors { done, total } => Some((900 * done / total.max(1)) as u64),
+                SolveEvent::Sweep { .. } => Some(900),
+                // Within a shot: the bar stays where the last shot left it.
+                SolveEvent::ShotFactors { .. } => None,
             };
-            progress.done.store(done, Ordering::Relaxed);
+            if let Some(done) = done {
+                progress.done.store(done, Ordering::Relaxed);
+            }
             let stop = progress.cancelled();
             observe(&event);
             if stop {

@@ -29,7 +29,7 @@ use thiserror::Error;
 use self::matrix_solvers::{IterationSettings, SolveError, solve_gauss_seidel, solve_jacobi};
 use self::progressive::{
     CLOSURE_SLACK, ClosureReport, ProgressiveError, ProgressiveSettings, ProgressiveState,
-    ShooterSelection, ShootingFactors, Start, solve_progressive_start,
+    ShooterSelection, ShootingFactors, Start, solve_progressive_stoppable,
 };
 use crate::formfactor::hemicube::{HemiCube, HemiCubeError};
 use crate::formfactor::matrix::FormFactorMatrix;
@@ -208,6 +208,9 @@ pub enum SolveEvent<'a> {
     Factors { done: usize, total: usize },
     /// A matrix-solver sweep finished.
     Sweep { sweep: usize, residual: f64 },
+    /// Receivers of the current progressive shot whose factors are done (between
+    /// blocks of a shot, so that a stop is honoured within a shot).
+    ShotFactors { done: usize, total: usize },
     /// A progressive shot finished; `fraction_done` runs from 0 to 1 on a log scale of
     /// the unshot power. `scene` is the mesh the state belongs to (it changes between
     /// the passes of an adaptive solve).
@@ -390,7 +393,9 @@ pub fn solve_start<V: Visibility>(
                 }
             };
             let log_tolerance = settings.tolerance.ln();
-            let report = solve_progressive_start(
+            // Both hooks report to `on_event`, one after each shot, one within shots.
+            let on_event_cell = std::cell::RefCell::new(&mut on_event);
+            let report = solve_progressive_stoppable(
                 set,
                 factors,
                 vis,
@@ -404,12 +409,13 @@ pub fn solve_start<V: Visibility>(
                 |state| {
                     let fraction = state.unshot_fraction().max(f64::MIN_POSITIVE);
                     let fraction_done = (fraction.ln() / log_tolerance).clamp(0.0, 1.0);
-                    on_event(SolveEvent::Shot {
+                    (on_event_cell.borrow_mut())(SolveEvent::Shot {
                         scene,
                         state,
                         fraction_done,
                     })
                 },
+                |done, total| (on_event_cell.borrow_mut())(SolveEvent::ShotFactors { done, total }),
             )?;
             let state = report.state;
             let ambient = state.ambient(set);

@@ -222,11 +222,17 @@ impl Visibility for FaceVisibility {
         self.occluders == 0 && self.contacts.covered() == 0
     }
 
-    fn prepare_shot(&self, set: &PatchSet, source: usize, shot: &mut ShotCull) {
+    fn prepare_shot(
+        &self,
+        set: &PatchSet,
+        source: usize,
+        shot: &mut ShotCull,
+        go_on: &mut dyn FnMut() -> bool,
+    ) -> bool {
         // Receivers that exchange light with the shooter lie in front of it, so every
         // ray of the shot ends at its centroid lifted along its normal.
         let apex = set.patches[source].centroid + self.lifts[source].as_dvec3();
-        self.shafts.prepare(source, apex, self.lift, shot);
+        self.shafts.prepare(source, apex, self.lift, shot, go_on)
     }
 
     fn visible_in_shot(
@@ -299,10 +305,16 @@ impl Visibility for SceneVisibility<'_> {
         }
     }
 
-    fn prepare_shot(&self, set: &PatchSet, source: usize, shot: &mut ShotCull) {
+    fn prepare_shot(
+        &self,
+        set: &PatchSet,
+        source: usize,
+        shot: &mut ShotCull,
+        go_on: &mut dyn FnMut() -> bool,
+    ) -> bool {
         match self {
-            SceneVisibility::Faces(v) => v.prepare_shot(set, source, shot),
-            SceneVisibility::World(v) => v.prepare_shot(set, source, shot),
+            SceneVisibility::Faces(v) => v.prepare_shot(set, source, shot, go_on),
+            SceneVisibility::World(v) => v.prepare_shot(set, source, shot, go_on),
         }
     }
 
