@@ -284,7 +284,7 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
     };
     // The context first: its world reads the light-sampler parameter.
     let (ctx, w) = RenderContext::new(&desc, &overrides)?;
-    let settings = RadiositySettings::from_desc(&desc.integrator)?;
+    let settings = RadiositySettings::for_scene(&desc.integrator, &desc)?;
     for w in desc
         .integrator
         .params
@@ -463,6 +463,23 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
         );
     }
     out!("{}", solution.balance.summary());
+    if let Some(warning) = solution
+        .balance
+        .escape_warning()
+        .filter(|_| !solution.interrupted)
+    {
+        eprintln!("warning: {warning}");
+    }
+    // Rows a little above 1 are the centroid estimate's error next to much smaller
+    // neighbours and are scaled quietly; far above 1 the mesh hides a modelling problem.
+    if solution.closure.largest_row_sum > 1.5 || solution.closure.non_finite > 0 {
+        eprintln!(
+            "warning: radiosity: {} form-factor row(s) summed above 1 (largest {:.3}) and were scaled to 1, {} had non-finite factors (surfaces closer than the factors can resolve, or patches much larger than their neighbours where surfaces meet)",
+            solution.closure.scaled_rows,
+            solution.closure.largest_row_sum,
+            solution.closure.non_finite
+        );
+    }
     if let Some(path) = &args.save_solution
         && !solution.interrupted
     {

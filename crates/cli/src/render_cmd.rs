@@ -424,6 +424,22 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         }
     }
 
+    // A radiosity solve that diverged leaves no image: an error, not a black picture.
+    if let Some(failure) = output_data
+        .stats
+        .get::<radiant::radiosity::integrator::RadiosityFailure>()
+    {
+        bail!("{failure}; no image written");
+    }
+    // Interrupted solves have not distributed their light yet: no escape warning.
+    if let Some(warning) = output_data
+        .stats
+        .get::<radiant::radiosity::solve::RadiosityStats>()
+        .filter(|_| !output_data.interrupted)
+        .and_then(|s| s.balance.escape_warning())
+    {
+        eprintln!("warning: {warning}");
+    }
     // Stopped before every pixel had a sample (photon tracing, radiosity solve, the first
     // pass): such an image would pass for a black render, so the previous file stays.
     if output_data.interrupted && output_data.spp_done == 0 {

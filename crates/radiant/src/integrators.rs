@@ -40,7 +40,7 @@ pub fn integrator_from_desc(
         }),
         "radiosity" => {
             let (radiosity, w) =
-                RadiosityIntegrator::new(scene, RadiositySettings::from_desc(desc)?)?;
+                RadiosityIntegrator::new(scene, RadiositySettings::for_scene(desc, scene)?)?;
             warnings.extend(w);
             Box::new(radiosity)
         }

@@ -142,6 +142,7 @@ pub fn read(
         interrupted: false,
         factor_seconds: 0.0,
         seconds: 0.0,
+        closure: Default::default(),
     })
 }
 

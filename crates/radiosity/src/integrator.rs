@@ -47,7 +47,29 @@ impl Integrator for RadiosityIntegrator {
     fn render(&self, ctx: &RenderContext, control: &mut RenderControl<'_>) -> RenderOutput {
         let start = Instant::now();
         let settings = &self.settings;
-        let solved = solve_session(&ctx.world, &self.scene, settings, control.progress);
+        let solved = match solve_session_observed(
+            &ctx.world,
+            &self.scene,
+            settings,
+            control.progress,
+            |_| {},
+        ) {
+            Ok(solved) => solved,
+            Err(e) => {
+                // No image of a failed solve: the caller finds the failure in the stats
+                // and reports it instead of writing a black picture.
+                return RenderOutput {
+                    film: ctx.new_film(),
+                    seconds: start.elapsed().as_secs_f64(),
+                    rays: 0,
+                    spp_done: 0,
+                    interrupted: false,
+                    state: None,
+                    stats: Stats::new(RadiosityFailure(e.to_string())),
+                    blocks: Vec::new(),
+                };
+            }
+        };
         let scene = solved.scene(&self.scene);
         let solution = &solved.solution;
         let display = solution.display_radiosity(&scene.patches);
@@ -70,6 +92,16 @@ impl Integrator for RadiosityIntegrator {
             balance: solution.balance,
         });
         out
+    }
+}
+
+/// The report of a radiosity render whose solve failed (diverged): the reason.
+#[derive(Clone, Debug)]
+pub struct RadiosityFailure(pub String);
+
+impl std::fmt::Display for RadiosityFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
     }
 }
 
@@ -98,8 +130,9 @@ pub fn solve_session(
 ) -> AdaptiveSolution {
     solve_session_observed(world, scene, settings, progress, |_| {})
         // Settings were validated when the session was built (hemi-cube resolution) and
-        // the patch set and its solver inputs come from one scene, so no error can remain.
-        .expect("radiosity inputs are consistent")
+        // the patch set and its solver inputs come from one scene; what remains is a
+        // solve that diverged, which callers that cannot report errors must not show.
+        .unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// [`solve_session`], showing every solver event to `observe` as well (the CLI writes
@@ -137,11 +170,15 @@ pub fn solve_session_resumed(
         resume,
         |event| {
             let done = match event {
-                SolveEvent::Shot { fraction_done, .. } => (1000.0 * fraction_done) as u64,
-                SolveEvent::Factors { done, total } => (900 * done / total.max(1)) as u64,
-                SolveEvent::Sweep { .. } => 900,
+                SolveEvent::Shot { fraction_done, .. } => Some((1000.0 * fraction_done) as u64),
+                SolveEvent::Factors { done, total } => Some((900 * done / total.max(1)) as u64),
+                SolveEvent::Sweep { .. } => Some(900),
+                // Within a shot: the bar stays where the last shot left it.
+                SolveEvent::ShotFactors { .. } => None,
             };
-            progress.done.store(done, Ordering::Relaxed);
+            if let Some(done) = done {
+                progress.done.store(done, Ordering::Relaxed);
+            }
             let stop = progress.cancelled();
             observe(&event);
             if stop {

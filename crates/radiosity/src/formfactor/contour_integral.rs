@@ -22,11 +22,31 @@
 
 use glam::DVec3;
 
+/// Heights above a polygon's plane, relative to the size of the configuration, below
+/// which a point counts as lying in the plane: far above the rounding of points shared
+/// by a patch and its back twin (1e-15 relative), far below the heights graded
+/// quadrature reaches next to a shared edge (1e-7 of a patch), where a perpendicular
+/// neighbour still fills half the hemisphere.
+const IN_PLANE: f64 = 1e-9;
+
 /// Exact form factor from a differential area at `x` with unit normal `n` to the planar
 /// polygon `corners` (counter-clockwise seen from the side `polygon_normal` points to).
 /// Zero when `x` is behind or in the polygon's plane. Visibility is not considered.
 pub fn point_polygon_factor(x: DVec3, n: DVec3, corners: &[DVec3], polygon_normal: DVec3) -> f64 {
-    if corners.len() < 3 || (x - corners[0]).dot(polygon_normal) <= 0.0 {
+    if corners.len() < 3 {
+        return 0.0;
+    }
+    // A point in the polygon's plane sees none of it. The test must allow for
+    // rounding: a point on the back twin of a two-sided patch (the same corners in
+    // reverse order) lies in the plane only up to rounding, and with a positive height
+    // of 1e-13 the clipped contour closes around the whole polygon and gives F = 1,
+    // so every two-sided patch sent all its light to its own back side (a row sum of
+    // about 2 and a diverging solve). Distinct faces that meet in a plane up to the
+    // f32 rounding of their input (a box's bottom on the floor) are cut off as
+    // contacts by the visibility instead (`visibility::contact`).
+    let offset = x - corners[0];
+    let scale = offset.length() + (corners[1] - corners[0]).length();
+    if offset.dot(polygon_normal) <= IN_PLANE * scale {
         return 0.0;
     }
     let mut contour = ContourSum::new(n);
@@ -142,6 +162,22 @@ mod tests {
             DVec3::new(half, half, z),
             DVec3::new(half, -half, z),
         ]
+    }
+
+    #[test]
+    fn a_point_on_the_back_twin_sees_nothing_of_its_front() {
+        // The back side of a two-sided patch lies in its plane up to rounding: a
+        // height of 1e-13 must not make the clipped contour close around the whole
+        // polygon (F = 1).
+        let front = square(0.0, 0.5);
+        let up = DVec3::Z;
+        for h in [0.0, 1e-13, 1e-9] {
+            let x = DVec3::new(0.1, -0.2, -h);
+            assert_eq!(point_polygon_factor(x, up, &front, -up), 0.0, "{h}");
+        }
+        // Resolvable heights still see the square (nearly all of the hemisphere).
+        let f = point_polygon_factor(DVec3::new(0.1, -0.2, -1e-4), up, &front, -up);
+        assert!(f > 0.99, "{f}");
     }
 
     #[test]

@@ -28,8 +28,8 @@ use thiserror::Error;
 
 use self::matrix_solvers::{IterationSettings, SolveError, solve_gauss_seidel, solve_jacobi};
 use self::progressive::{
-    ProgressiveError, ProgressiveSettings, ProgressiveState, ShooterSelection, ShootingFactors,
-    Start, solve_progressive_start,
+    CLOSURE_SLACK, ClosureReport, ProgressiveError, ProgressiveSettings, ProgressiveState,
+    ShooterSelection, ShootingFactors, Start, solve_progressive_stoppable,
 };
 use crate::formfactor::hemicube::{HemiCube, HemiCubeError};
 use crate::formfactor::matrix::FormFactorMatrix;
@@ -51,6 +51,8 @@ pub enum RadiosityError {
     Solve(#[from] SolveError),
     #[error(transparent)]
     HemiCube(#[from] HemiCubeError),
+    #[error("{0}")]
+    Diverged(String),
 }
 
 /// Power per band (W, or the scene's units of power): what the lights send, where it
@@ -73,6 +75,47 @@ impl PowerBalance {
     pub fn imbalance(&self) -> [f64; 3] {
         std::array::from_fn(|b| {
             self.emitted[b] - self.absorbed[b] - self.escaped[b] - self.unshot[b]
+        })
+    }
+
+    /// Why the balance shows a failed solve, if it does: a non-finite figure, or more
+    /// power absorbed, escaped or left unshot than was emitted (the iteration grew
+    /// instead of converging). Such a solution must not be shown as an image.
+    pub fn failure(&self) -> Option<String> {
+        let figures = [self.emitted, self.absorbed, self.escaped, self.unshot];
+        if figures.iter().flatten().any(|v| !v.is_finite()) {
+            return Some(format!(
+                "the radiosity solve diverged (non-finite power); {}",
+                self.summary()
+            ));
+        }
+        // Each of absorbed, escaped and unshot is a share of the emitted power, up to
+        // the matrix solvers' residual and reciprocity error (a few per cent at most).
+        let exploded = (0..3).any(|b| {
+            let limit = 1.5 * self.emitted[b].abs() + f64::MIN_POSITIVE;
+            [self.absorbed[b], self.escaped[b], self.unshot[b]]
+                .iter()
+                .any(|v| v.abs() > limit)
+        });
+        exploded.then(|| {
+            format!(
+                "the radiosity solve diverged (power grew beyond the emitted power); {}",
+                self.summary()
+            )
+        })
+    }
+
+    /// A warning when more than half of the emitted power (summed over bands) left the
+    /// scene without reaching a patch: usually surfaces facing away from the light
+    /// (one-sided patches of a scene wound the other way) rather than an open scene.
+    pub fn escape_warning(&self) -> Option<String> {
+        let emitted: f64 = self.emitted.iter().sum();
+        let escaped: f64 = self.escaped.iter().sum();
+        (emitted > 0.0 && escaped > 0.5 * emitted).then(|| {
+            format!(
+                "radiosity: {:.0} % of the emitted power escaped without reaching a patch; if the scene is closed, its surfaces may face away from the light (try \"bool twosided\" true)",
+                100.0 * escaped / emitted
+            )
         })
     }
 
@@ -144,6 +187,8 @@ pub struct Solution {
     /// Seconds spent on the factor matrix (matrix solvers) and in total.
     pub factor_seconds: f64,
     pub seconds: f64,
+    /// Rows of form factors that summed to more than 1 and were scaled to closure.
+    pub closure: ClosureReport,
 }
 
 impl Solution {
@@ -163,6 +208,9 @@ pub enum SolveEvent<'a> {
     Factors { done: usize, total: usize },
     /// A matrix-solver sweep finished.
     Sweep { sweep: usize, residual: f64 },
+    /// Receivers of the current progressive shot whose factors are done (between
+    /// blocks of a shot, so that a stop is honoured within a shot).
+    ShotFactors { done: usize, total: usize },
     /// A progressive shot finished; `fraction_done` runs from 0 to 1 on a log scale of
     /// the unshot power. `scene` is the mesh the state belongs to (it changes between
     /// the passes of an adaptive solve).
@@ -345,7 +393,9 @@ pub fn solve_start<V: Visibility>(
                 }
             };
             let log_tolerance = settings.tolerance.ln();
-            let report = solve_progressive_start(
+            // Both hooks report to `on_event`, one after each shot, one within shots.
+            let on_event_cell = std::cell::RefCell::new(&mut on_event);
+            let report = solve_progressive_stoppable(
                 set,
                 factors,
                 vis,
@@ -359,12 +409,13 @@ pub fn solve_start<V: Visibility>(
                 |state| {
                     let fraction = state.unshot_fraction().max(f64::MIN_POSITIVE);
                     let fraction_done = (fraction.ln() / log_tolerance).clamp(0.0, 1.0);
-                    on_event(SolveEvent::Shot {
+                    (on_event_cell.borrow_mut())(SolveEvent::Shot {
                         scene,
                         state,
                         fraction_done,
                     })
                 },
+                |done, total| (on_event_cell.borrow_mut())(SolveEvent::ShotFactors { done, total }),
             )?;
             let state = report.state;
             let ambient = state.ambient(set);
@@ -383,6 +434,7 @@ pub fn solve_start<V: Visibility>(
                 interrupted: report.stopped,
                 factor_seconds: 0.0,
                 seconds: 0.0,
+                closure: report.closure,
             }
         }
         SolverKind::GaussSeidel | SolverKind::Jacobi => {
@@ -403,8 +455,10 @@ pub fn solve_start<V: Visibility>(
                     interrupted: true,
                     factor_seconds: factor_start.elapsed().as_secs_f64(),
                     seconds: start.elapsed().as_secs_f64(),
+                    closure: ClosureReport::default(),
                 });
             };
+            let (f, closure) = f;
             let factor_seconds = factor_start.elapsed().as_secs_f64();
             let iteration = IterationSettings {
                 tolerance: settings.tolerance,
@@ -435,6 +489,7 @@ pub fn solve_start<V: Visibility>(
                 interrupted: false,
                 factor_seconds,
                 seconds: 0.0,
+                closure,
             }
         }
     };
@@ -466,6 +521,23 @@ pub fn solve_start<V: Visibility>(
         }
     }
     solution.seconds = start.elapsed().as_secs_f64();
+    // Bad results never pass silently: a solve that blew up is an error, not an
+    // all-black image.
+    let finite = solution
+        .radiosity
+        .iter()
+        .chain(&solution.irradiance)
+        .flatten()
+        .all(|v| v.is_finite());
+    if !finite {
+        return Err(RadiosityError::Diverged(format!(
+            "the radiosity solve diverged (non-finite radiosity); {}",
+            solution.balance.summary()
+        )));
+    }
+    if let Some(failure) = solution.balance.failure() {
+        return Err(RadiosityError::Diverged(failure));
+    }
     Ok(solution)
 }
 
@@ -479,7 +551,7 @@ fn factor_matrix<V: Visibility>(
     settings: &RadiositySettings,
     vis: &V,
     on_event: &mut impl FnMut(SolveEvent<'_>) -> ControlFlow<()>,
-) -> Result<Option<FormFactorMatrix<f64>>, RadiosityError> {
+) -> Result<Option<(FormFactorMatrix<f64>, ClosureReport)>, RadiosityError> {
     let n = set.len();
     let mut values = vec![0.0; n * n];
     // A row costs about n patch projections (hemi-cube) or ray casts, so a block of
@@ -512,7 +584,169 @@ fn factor_matrix<V: Visibility>(
             }
         }
     }
-    Ok(Some(
+    let closure = enforce_closure(n, &mut values);
+    Ok(Some((
         FormFactorMatrix::from_row_major(n, values).expect("n x n values"),
-    ))
+        closure,
+    )))
+}
+
+/// Scales every row of the row-major `n x n` factors that sums to more than
+/// `1 + CLOSURE_SLACK` back to 1, and zeroes non-finite factors. The factors leaving
+/// one side of a patch cannot sum to more than 1 (Cohen & Wallace, "Radiosity and
+/// Realistic Image Synthesis", sec. 4.1); a row that does makes `rho F` expand energy,
+/// and with reflectances near 1 the Jacobi and Gauss-Seidel iterations diverge.
+pub fn enforce_closure(n: usize, values: &mut [f64]) -> ClosureReport {
+    let mut report = ClosureReport::default();
+    if n == 0 {
+        return report;
+    }
+    for row in values.chunks_mut(n) {
+        if row.iter().any(|f| !f.is_finite()) {
+            report.non_finite += 1;
+            row.iter_mut()
+                .filter(|f| !f.is_finite())
+                .for_each(|f| *f = 0.0);
+        }
+        let sum: f64 = row.iter().sum();
+        if sum > 1.0 + CLOSURE_SLACK {
+            report.scaled_rows += 1;
+            report.largest_row_sum = report.largest_row_sum.max(sum);
+            row.iter_mut().for_each(|f| *f /= sum);
+        }
+    }
+    report
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::visibility::bvh::FaceVisibility;
+    use glam::Vec3;
+    use radiant_scene::builtin::cornell_box;
+    use radiant_scene::{FileLoc, ShapeDesc};
+
+    /// The Cornell box with a 100-unit white cube whose bottom face lies on the floor
+    /// (back to back with it), meshed two-sided.
+    fn box_with_a_cube_on_the_floor() -> RadiosityScene {
+        let mut desc = cornell_box();
+        let material = desc.shapes[0].material;
+        let (x0, x1, z0, z1, h) = (380.0, 480.0, 60.0, 160.0, 100.0);
+        let p = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
+        let faces = [
+            [
+                p(x0, 0.0, z0),
+                p(x1, 0.0, z0),
+                p(x1, 0.0, z1),
+                p(x0, 0.0, z1),
+            ],
+            [p(x0, h, z0), p(x0, h, z1), p(x1, h, z1), p(x1, h, z0)],
+            [p(x0, 0.0, z0), p(x0, h, z0), p(x1, h, z0), p(x1, 0.0, z0)],
+            [p(x0, 0.0, z1), p(x1, 0.0, z1), p(x1, h, z1), p(x0, h, z1)],
+            [p(x0, 0.0, z0), p(x0, 0.0, z1), p(x0, h, z1), p(x0, h, z0)],
+            [p(x1, 0.0, z0), p(x1, h, z0), p(x1, h, z1), p(x1, 0.0, z1)],
+        ];
+        desc.shapes
+            .push(ShapeDesc::quads(&faces, material, FileLoc::builtin("test")));
+        let settings = RadiositySettings {
+            max_patch_area: Some(2500.0),
+            two_sided: true,
+            ..RadiositySettings::default()
+        };
+        RadiosityScene::from_desc(&desc, &settings).unwrap()
+    }
+
+    #[test]
+    fn a_two_sided_box_with_a_cube_on_the_floor_stays_finite_and_closed() {
+        let scene = box_with_a_cube_on_the_floor();
+        let vis = FaceVisibility::new(&scene);
+        // The floor under the cube and the cube's bottom cover each other.
+        assert!(vis.covered_patches() > 0);
+        let settings = RadiositySettings {
+            max_patch_area: Some(2500.0),
+            two_sided: true,
+            tolerance: 1e-3,
+            ..RadiositySettings::default()
+        };
+        let sphere = SceneSphere {
+            center: Vec3::splat(278.0),
+            radius: 500.0,
+        };
+        let solution = solve(&scene, &[], sphere, &settings, &vis, |_| {
+            ControlFlow::Continue(())
+        })
+        .unwrap();
+        assert!(solution.converged);
+        let balance = solution.balance;
+        assert!(balance.failure().is_none(), "{}", balance.summary());
+        for b in 0..3 {
+            // Energy balance: emitted = absorbed + escaped + unshot, every share
+            // between 0 and the emitted power.
+            assert!(balance.imbalance()[b].abs() < 1e-9 * balance.emitted[b]);
+            for share in [balance.absorbed[b], balance.escaped[b], balance.unshot[b]] {
+                assert!((-1e-9..=1.0).contains(&(share / balance.emitted[b])));
+            }
+        }
+        // Closure: no shooter's row of factors came out above 1 by more than the
+        // centroid estimate's error next to small neighbours (a patch coupled to its
+        // own back side, or one seeing through a face lying on it, sums to about 2).
+        assert!(
+            solution.closure.largest_row_sum < 1.5,
+            "{:?}",
+            solution.closure
+        );
+        // No light reaches the inside of the closed cube, nor the floor under it.
+        let lit = solution.radiosity.iter().map(|b| b[0]).fold(0.0, f64::max);
+        for (patch, b) in scene.patches.patches.iter().zip(&solution.radiosity) {
+            let c = patch.centroid;
+            let inside =
+                (380.5..479.5).contains(&c.x) && (60.5..159.5).contains(&c.z) && c.y < 99.5;
+            if inside {
+                assert!(b[0] < 1e-9 * lit, "{c:?} {:?} {lit}: {b:?}", patch.normal);
+            }
+        }
+    }
+
+    #[test]
+    fn rows_above_one_are_scaled_to_closure() {
+        let mut values = vec![0.5, 0.9, 0.0, 0.2, 0.3, 0.1, f64::NAN, 0.4, 0.0];
+        let report = enforce_closure(3, &mut values);
+        assert_eq!(report.scaled_rows, 1);
+        assert_eq!(report.non_finite, 1);
+        assert!((report.largest_row_sum - 1.4).abs() < 1e-12);
+        for row in values.chunks(3) {
+            let sum: f64 = row.iter().sum();
+            assert!(sum.is_finite() && sum <= 1.0 + 1e-12, "{row:?}");
+        }
+        assert_eq!(&values[3..6], &[0.2, 0.3, 0.1]);
+    }
+
+    #[test]
+    fn a_diverged_balance_is_a_failure() {
+        let ok = PowerBalance {
+            emitted: [1.0; 3],
+            absorbed: [0.6; 3],
+            escaped: [0.4; 3],
+            unshot: [0.0; 3],
+        };
+        assert!(ok.failure().is_none());
+        assert!(ok.escape_warning().is_none());
+        let nan = PowerBalance {
+            absorbed: [f64::NAN, 0.6, 0.6],
+            ..ok
+        };
+        assert!(nan.failure().is_some());
+        let exploded = PowerBalance {
+            absorbed: [8.6e73, 0.6, 0.6],
+            escaped: [-1.5e74, 0.4, 0.4],
+            ..ok
+        };
+        assert!(exploded.failure().is_some());
+        let open = PowerBalance {
+            absorbed: [0.12; 3],
+            escaped: [0.88; 3],
+            ..ok
+        };
+        assert!(open.escape_warning().unwrap().contains("88 %"));
+    }
 }

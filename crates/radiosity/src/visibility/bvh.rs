@@ -8,6 +8,7 @@
 
 use glam::{DVec3, Vec3};
 
+use super::contact::Contacts;
 use super::shaft::ShaftCuller;
 use super::{ShotCull, Visibility};
 use crate::mesh::meshed_scene::RadiosityScene;
@@ -92,6 +93,8 @@ pub struct FaceVisibility {
     lift: f64,
     occluders: usize,
     shafts: ShaftCuller,
+    /// Patches covered by a face lying on them, closer than the lift.
+    contacts: Contacts,
 }
 
 /// Ray ends are lifted off their patches by this fraction of the scene's size: far
@@ -176,7 +179,11 @@ impl FaceVisibility {
         }
         let soup: Vec<[Vec3; 3]> = triangles.iter().map(|t| t.map(|p| p.as_vec3())).collect();
         let lift = (LIFT * size) as f32;
+        // A face closer to a patch than twice the lift (both ends are lifted) is behind
+        // the rays' origins and cannot occlude them: such contacts are cut explicitly.
+        let contacts = Contacts::new(scene, 2.0 * LIFT * size);
         FaceVisibility {
+            contacts,
             bvh: TriangleBvh::from_soup(&soup),
             lifts: patch_normals(&scene.patches)
                 .into_iter()
@@ -194,6 +201,11 @@ impl FaceVisibility {
         }
     }
 
+    /// Number of patches covered by a face lying on them (see [`Contacts`]).
+    pub fn covered_patches(&self) -> usize {
+        self.contacts.covered()
+    }
+
     /// Number of triangles that can block a shadow ray.
     pub fn occluder_count(&self) -> usize {
         self.occluders
@@ -207,14 +219,20 @@ impl FaceVisibility {
 
 impl Visibility for FaceVisibility {
     fn always_visible(&self) -> bool {
-        self.occluders == 0
+        self.occluders == 0 && self.contacts.covered() == 0
     }
 
-    fn prepare_shot(&self, set: &PatchSet, source: usize, shot: &mut ShotCull) {
+    fn prepare_shot(
+        &self,
+        set: &PatchSet,
+        source: usize,
+        shot: &mut ShotCull,
+        go_on: &mut dyn FnMut() -> bool,
+    ) -> bool {
         // Receivers that exchange light with the shooter lie in front of it, so every
         // ray of the shot ends at its centroid lifted along its normal.
         let apex = set.patches[source].centroid + self.lifts[source].as_dvec3();
-        self.shafts.prepare(source, apex, self.lift, shot);
+        self.shafts.prepare(source, apex, self.lift, shot, go_on)
     }
 
     fn visible_in_shot(
@@ -225,6 +243,9 @@ impl Visibility for FaceVisibility {
         from_patch: usize,
         to_patch: usize,
     ) -> bool {
+        if self.contacts.separated(from_patch, to_patch) {
+            return false;
+        }
         if from_patch >= self.lifts.len() || to_patch >= self.lifts.len() {
             return self.visible(from, to, from_patch, to_patch);
         }
@@ -243,6 +264,9 @@ impl Visibility for FaceVisibility {
     }
 
     fn visible(&self, from: DVec3, to: DVec3, from_patch: usize, to_patch: usize) -> bool {
+        if self.contacts.separated(from_patch, to_patch) {
+            return false;
+        }
         if self.occluders == 0 {
             return true;
         }
@@ -281,10 +305,16 @@ impl Visibility for SceneVisibility<'_> {
         }
     }
 
-    fn prepare_shot(&self, set: &PatchSet, source: usize, shot: &mut ShotCull) {
+    fn prepare_shot(
+        &self,
+        set: &PatchSet,
+        source: usize,
+        shot: &mut ShotCull,
+        go_on: &mut dyn FnMut() -> bool,
+    ) -> bool {
         match self {
-            SceneVisibility::Faces(v) => v.prepare_shot(set, source, shot),
-            SceneVisibility::World(v) => v.prepare_shot(set, source, shot),
+            SceneVisibility::Faces(v) => v.prepare_shot(set, source, shot, go_on),
+            SceneVisibility::World(v) => v.prepare_shot(set, source, shot, go_on),
         }
     }
 

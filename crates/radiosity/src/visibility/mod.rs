@@ -6,6 +6,7 @@
 //! - [`shaft`]: shaft culling, the few occluders that matter per progressive shot.
 
 pub mod bvh;
+pub mod contact;
 pub mod shaft;
 
 use glam::DVec3;
@@ -28,7 +29,17 @@ pub trait Visibility: Sync {
     /// Optional speed-up for the many queries of one progressive shot (rays between
     /// patch `source` and every receiver): prepares `shot` (e.g. the occluders that can
     /// matter per group of receivers). The default prepares nothing.
-    fn prepare_shot(&self, _set: &PatchSet, _source: usize, _shot: &mut ShotCull) {}
+    /// `go_on` is asked between blocks of the work (it can take seconds on large
+    /// scenes); when it answers false the preparation stops and this returns false.
+    fn prepare_shot(
+        &self,
+        _set: &PatchSet,
+        _source: usize,
+        _shot: &mut ShotCull,
+        _go_on: &mut dyn FnMut() -> bool,
+    ) -> bool {
+        true
+    }
 
     /// [`Visibility::visible`] for a query of the shot `shot` was prepared for.
     fn visible_in_shot(

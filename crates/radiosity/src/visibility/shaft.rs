@@ -15,6 +15,7 @@
 use std::collections::HashMap;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::mesh::patch::PatchSet;
 
@@ -70,6 +71,10 @@ fn bounding_sphere(points: &[DVec3]) -> (DVec3, f64) {
         .fold(0.0, f64::max);
     (centre, radius)
 }
+
+/// Tile-occluder tests between two stop checks of a shot's preparation (tens of
+/// milliseconds).
+const TILE_BLOCK_WORK: usize = 1 << 22;
 
 /// Occluders and receiver tiles.
 #[derive(Clone, Debug, Default)]
@@ -140,7 +145,16 @@ impl ShaftCuller {
 
     /// Fills `shot` with the candidate occluders of every tile for rays from receivers
     /// (lifted off their patches by at most `lift`) to `apex` on patch `source`.
-    pub fn prepare(&self, source: usize, apex: DVec3, lift: f64, shot: &mut ShotCull) {
+    /// Returns false, with `shot` left unprepared, when `go_on` (asked between blocks
+    /// of tiles) answers false.
+    pub fn prepare(
+        &self,
+        source: usize,
+        apex: DVec3,
+        lift: f64,
+        shot: &mut ShotCull,
+        go_on: &mut dyn FnMut() -> bool,
+    ) -> bool {
         shot.source = source;
         shot.apex = apex;
         shot.start.clear();
@@ -171,9 +185,11 @@ impl ShaftCuller {
                 Some((h.signum(), sides))
             })
             .collect();
-        for tile in &self.tiles {
-            shot.start.push(shot.list.len() as u32);
+        // Tiles times occluders is most of a shot's work on large scenes (seconds), so
+        // tiles go in parallel blocks with a stop check between them.
+        let candidates = |tile: &Tile| -> Vec<u32> {
             let r = tile.radius + lift + self.tolerance;
+            let mut list = Vec::new();
             for (k, (o, pyramid)) in self.occluders.iter().zip(&pyramids).enumerate() {
                 let Some((side, planes)) = pyramid else {
                     continue;
@@ -186,10 +202,26 @@ impl ShaftCuller {
                 if planes.iter().any(|m| m.dot(tile.centre - apex) < -r) {
                     continue;
                 }
-                shot.list.push(k as u32);
+                list.push(k as u32);
+            }
+            list
+        };
+        let block = (TILE_BLOCK_WORK / self.occluders.len().max(1)).max(16);
+        for tiles in self.tiles.chunks(block) {
+            let lists: Vec<Vec<u32>> = tiles.par_iter().map(candidates).collect();
+            for list in lists {
+                shot.start.push(shot.list.len() as u32);
+                shot.list.extend(list);
+            }
+            if shot.start.len() < self.tiles.len() && !go_on() {
+                // Unprepared: `prepared_for` must not accept a partial list.
+                shot.start.clear();
+                shot.list.clear();
+                return false;
             }
         }
         shot.start.push(shot.list.len() as u32);
+        true
     }
 
     /// Whether any candidate of `patch`'s tile in `shot` blocks the segment from `o` to
