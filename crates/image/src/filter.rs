@@ -56,8 +56,9 @@ pub struct FilterSample {
     /// triangle; for the Gaussian, whose pdf is a tabulated approximation of f, within
     /// 1.4e-3 of 1 per axis (measured; 1.5e-5 for |offset| < 1 at the default σ 0.5).
     /// Filters with negative lobes (Mitchell, Lanczos) are sampled by |f|, so an offset in
-    /// a negative lobe has a negative weight, about −∫|f| / ∫f; the film's weighted mean
-    /// then rings as the filter does, as in pbrt-v4.
+    /// a negative lobe has a negative weight, about −∫|f| / ∫f (the renderer then scales
+    /// the sample's radiance by it rather than weighing the sample in the film: see
+    /// `has_negative_lobes`).
     pub weight: f32,
 }
 
@@ -156,6 +157,11 @@ impl Filter {
             | Filter::Mitchell { tables, .. }
             | Filter::LanczosSinc { tables, .. } => Some(tables),
         }
+    }
+
+    /// Whether the filter has negative lobes, so that sample weights may be negative.
+    pub fn has_negative_lobes(&self) -> bool {
+        matches!(self, Filter::Mitchell { .. } | Filter::LanczosSinc { .. })
     }
 
     /// ∫ |eval| over the plane: the normalisation of the density offsets are drawn with.

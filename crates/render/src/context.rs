@@ -256,9 +256,22 @@ impl RenderContext {
         let fs = self.filter.sample(sampler.get_2d());
         let raster = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + fs.offset;
         let u_lens = sampler.get_2d_if(self.camera.uses_lens_sample());
-        let ray = self.camera.generate_ray(raster, u_lens);
+        let mut ray = self.camera.generate_ray(raster, u_lens);
         if ray.is_some() {
             crate::stats::add(crate::stats::Counter::CameraRays, 1);
+        }
+        if self.filter.has_negative_lobes() {
+            // Signed weights would make the film's weighted mean Σ w L / Σ w blow up
+            // wherever a pixel's few weights nearly cancel (one sample in a negative lobe
+            // of two gives ±10⁶). Carried by the radiance instead, with the film weighing
+            // every sample 1, the pixel is Σ w L / n: unbiased, as E[w] = 1, and bounded.
+            if let Some(r) = &mut ray {
+                r.weight *= fs.weight;
+            }
+            return CameraSample {
+                ray,
+                filter_weight: 1.0,
+            };
         }
         CameraSample {
             ray,
