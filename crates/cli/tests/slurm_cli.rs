@@ -171,26 +171,26 @@ fn values_cannot_add_lines_or_words_to_the_scripts() {
     std::fs::remove_dir_all(&d).ok();
 }
 
+/// A small job whose scripts go to the folder `job`.
+const CLEANUP_JOB: [&str; 9] = [
+    "slurm",
+    "--parts",
+    "2",
+    "--resolution",
+    "8x6",
+    "-o",
+    "out.exr",
+    "--dir",
+    "job",
+];
+
 #[test]
 fn a_failed_run_removes_the_folders_it_made() {
     let d = temp_dir("cleanup");
     // The job script cannot be written (a folder holds its name), as on a full disk.
     let job = d.join("job");
     std::fs::create_dir_all(job.join("render.sbatch")).unwrap();
-    let e = failure(
-        &d,
-        &[
-            "slurm",
-            "--parts",
-            "2",
-            "--resolution",
-            "8x6",
-            "-o",
-            "out.exr",
-            "--dir",
-            "job",
-        ],
-    );
+    let e = failure(&d, &CLEANUP_JOB);
     assert!(e.contains("render.sbatch"), "{e}");
     assert_eq!(
         entries(&job),
@@ -200,20 +200,7 @@ fn a_failed_run_removes_the_folders_it_made() {
     // A script written before the failure goes too.
     std::fs::remove_dir(job.join("render.sbatch")).unwrap();
     std::fs::create_dir(job.join("merge.sbatch")).unwrap();
-    let e = failure(
-        &d,
-        &[
-            "slurm",
-            "--parts",
-            "2",
-            "--resolution",
-            "8x6",
-            "-o",
-            "out.exr",
-            "--dir",
-            "job",
-        ],
-    );
+    let e = failure(&d, &CLEANUP_JOB);
     assert!(e.contains("merge.sbatch"), "{e}");
     assert_eq!(entries(&job), ["merge.sbatch"]);
     // With no sbatch to submit them, the folders the run made, to the top, are removed.

@@ -31,6 +31,29 @@ fn filters() -> Vec<(&'static str, Filter)> {
     ]
 }
 
+/// The chi-square test of `SAMPLES` offsets over a filter's support.
+fn over_support(name: &str, radius: Vec2) -> ChiSquareTest {
+    ChiSquareTest::new(
+        name,
+        Domain::Rectangle {
+            min: -radius,
+            max: radius,
+        },
+    )
+    .samples(SAMPLES)
+}
+
+/// The mean of `n` weights (their sum and sum of squares) is 1, E[f / (pdf ∫f)], within
+/// four standard errors.
+fn assert_mean_weight_is_one(name: &str, n: u64, sum: f64, sum2: f64) {
+    let mean = sum / n as f64;
+    let sd = ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
+    assert!(
+        (mean - 1.0).abs() <= 4.0 * sd + 1e-6,
+        "{name}: mean weight {mean} ± {sd}, expected 1"
+    );
+}
+
 /// How far the density a Gaussian weight implies, f / (weight ∫f), may be from f / ∫f:
 /// the sampler inverts a piecewise-linear interpolant of each axis, whose relative error
 /// is largest in the last segment before the radius (measured weights per axis within
@@ -49,38 +72,31 @@ fn filter_offsets_follow_the_normalised_filter() {
         assert!(integral > 0.0, "{name}");
         let gaussian = matches!(filter, Filter::Gaussian { .. });
         let (mut n, mut sum, mut sum2) = (0u64, 0.0f64, 0.0f64);
-        let report = ChiSquareTest::new(
-            name,
-            Domain::Rectangle {
-                min: -radius,
-                max: radius,
-            },
-        )
-        .samples(SAMPLES)
-        .seed(seed as u64 + 1)
-        .pdf_tolerance(if gaussian {
-            GAUSSIAN_PDF_TOLERANCE
-        } else {
-            1e-6
-        })
-        .run_with_pdf(
-            |u| {
-                let s = filter.sample(u.u2);
-                let w = s.weight as f64;
-                n += 1;
-                sum += w;
-                sum2 += w * w;
-                assert!(w.is_finite() && w > 0.0, "{name}: weight {w}");
-                if !gaussian {
-                    assert_eq!(s.weight, 1.0, "{name}: {s:?}");
-                }
-                // An offset on the support's rim (u = 0) has f = 0 and weight no
-                // density; it counts as no sample.
-                let f = filter.eval(s.offset) as f64;
-                (f > 0.0).then_some((s.offset, f / (w * integral)))
-            },
-            |p| filter.eval(p).abs() as f64 / integral,
-        );
+        let report = over_support(name, radius)
+            .seed(seed as u64 + 1)
+            .pdf_tolerance(if gaussian {
+                GAUSSIAN_PDF_TOLERANCE
+            } else {
+                1e-6
+            })
+            .run_with_pdf(
+                |u| {
+                    let s = filter.sample(u.u2);
+                    let w = s.weight as f64;
+                    n += 1;
+                    sum += w;
+                    sum2 += w * w;
+                    assert!(w.is_finite() && w > 0.0, "{name}: weight {w}");
+                    if !gaussian {
+                        assert_eq!(s.weight, 1.0, "{name}: {s:?}");
+                    }
+                    // An offset on the support's rim (u = 0) has f = 0 and weight no
+                    // density; it counts as no sample.
+                    let f = filter.eval(s.offset) as f64;
+                    (f > 0.0).then_some((s.offset, f / (w * integral)))
+                },
+                |p| filter.eval(p).abs() as f64 / integral,
+            );
         check(&report);
         // The harness integrates f / ∫f over the cells: ∫f must be the filter's integral.
         assert!(
@@ -94,13 +110,7 @@ fn filter_offsets_follow_the_normalised_filter() {
             "{name}: {} offsets on the rim",
             report.no_sample
         );
-        let mean = sum / n as f64;
-        let sd = ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
-        let expected = 1.0; // ∫f / ∫|f| for a non-negative filter
-        assert!(
-            (mean - expected).abs() <= 4.0 * sd + 1e-6,
-            "{name}: mean weight {mean} ± {sd}, expected {expected}"
-        );
+        assert_mean_weight_is_one(name, n, sum, sum2);
     }
 }
 
@@ -141,16 +151,7 @@ fn signed_filters_sample_their_magnitude_and_weights_average_one() {
             "{name}: {integral} {abs_integral}"
         );
         let (mut n, mut sum, mut sum2, mut negative) = (0u64, 0.0f64, 0.0f64, 0u64);
-        let report = ChiSquareTest::new(
-            name,
-            Domain::Rectangle {
-                min: -radius,
-                max: radius,
-            },
-        )
-        .samples(SAMPLES)
-        .seed(seed as u64 + 101)
-        .run(
+        let report = over_support(name, radius).seed(seed as u64 + 101).run(
             |u| {
                 let s = filter.sample(u.u2);
                 let w = s.weight as f64;
@@ -172,12 +173,7 @@ fn signed_filters_sample_their_magnitude_and_weights_average_one() {
             report.pdf_integral - 1.0
         );
         assert!(negative > 0, "{name}: no sample in a negative lobe");
-        let mean = sum / n as f64;
-        let sd = ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt();
-        assert!(
-            (mean - 1.0).abs() <= 4.0 * sd + 1e-6,
-            "{name}: mean weight {mean} ± {sd}, expected 1"
-        );
+        assert_mean_weight_is_one(name, n, sum, sum2);
     }
 }
 
