@@ -57,7 +57,8 @@ enum Command {
     /// in the test image, `nonfinite_ref` in the reference. A non-finite test value
     /// counts as 0, so a renderer's NaN raises its error (as `compare.py` treats it); a
     /// non-finite reference value leaves nothing to measure against, so that channel
-    /// value is left out of every figure, for both images.
+    /// value is left out of every figure, for both images (`--flip`, which compares
+    /// whole pixels, leaves out the pixel).
     Compare(compare_cmd::CompareArgs),
     /// Throughput figures: Mrays/s on the Cornell box and a 1M-triangle mesh, render time.
     Bench(bench_cmd::BenchArgs),

@@ -156,7 +156,10 @@ pub struct Measured {
 
 /// Errors of `test` against `reference` over `crop`: `compare`'s metrics and the mean of
 /// the HDR-ꟻLIP map (computed on the whole image, its filters need the neighbours)
-/// over the crop. Non-finite test values count as 0, as in `compare`.
+/// over the crop. Non-finite test values count as 0, as in `compare`. A reference pixel
+/// with a non-finite channel leaves nothing to measure against, as in `compare`: the
+/// test's pixel stands in for it, so that no made-up difference spreads through the
+/// filters to its neighbours, its error is 0 in the map, and the mean leaves it out.
 pub fn measure(
     test: &Image,
     reference: &Image,
@@ -164,29 +167,64 @@ pub fn measure(
     pixels_per_degree: f32,
 ) -> Result<Measured, StudyError> {
     let metrics = compare(test, reference, crop)?;
-    let finite = |img: &Image| -> Vec<[f32; 3]> {
-        img.pixels
-            .iter()
-            .map(|p| p.to_array().map(|v| if v.is_finite() { v } else { 0.0 }))
-            .collect()
-    };
-    let flip = flip_hdr(
-        &finite(test),
-        &finite(reference),
+    let finite = |p: [f32; 3]| p.map(|v| if v.is_finite() { v } else { 0.0 });
+    let test_pixels: Vec<[f32; 3]> = test.pixels.iter().map(|p| finite(p.to_array())).collect();
+    let unmeasured: Vec<bool> = reference
+        .pixels
+        .iter()
+        .map(|p| !p.to_array().iter().all(|v| v.is_finite()))
+        .collect();
+    let reference_pixels: Vec<[f32; 3]> = reference
+        .pixels
+        .iter()
+        .zip(&test_pixels)
+        .zip(&unmeasured)
+        .map(|((r, &t), &skip)| if skip { t } else { finite(r.to_array()) })
+        .collect();
+    let mut flip = flip_hdr(
+        &test_pixels,
+        &reference_pixels,
         test.width,
         test.height,
         pixels_per_degree,
         None,
     )?;
-    let flip_mean = match crop {
-        None => flip.mean,
-        Some(c) => crop_mean(&flip.errors, flip.width, c),
+    for (e, _) in flip.errors.iter_mut().zip(&unmeasured).filter(|(_, s)| **s) {
+        *e = 0.0;
+    }
+    let whole = Crop::full(test.width, test.height);
+    let flip_mean = if unmeasured.contains(&true) {
+        flip.mean = measured_mean(&flip.errors, &unmeasured, flip.width, whole);
+        measured_mean(&flip.errors, &unmeasured, flip.width, crop.unwrap_or(whole))
+    } else {
+        match crop {
+            None => flip.mean,
+            Some(c) => crop_mean(&flip.errors, flip.width, c),
+        }
     };
     Ok(Measured {
         metrics,
         flip,
         flip_mean,
     })
+}
+
+/// Mean of a row-major map over `crop`, leaving out the pixels marked in `skip`; NaN
+/// where every pixel is left out.
+fn measured_mean(values: &[f32], skip: &[bool], width: usize, crop: Crop) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for y in crop.y0..crop.y1 {
+        let row = y * width + crop.x0..y * width + crop.x1;
+        for (&v, _) in values[row.clone()]
+            .iter()
+            .zip(&skip[row])
+            .filter(|(_, s)| !**s)
+        {
+            sum += f64::from(v);
+            n += 1;
+        }
+    }
+    if n == 0 { f64::NAN } else { sum / n as f64 }
 }
 
 /// Mean of a row-major map over `crop`, summed in f64 in row order.
@@ -738,6 +776,56 @@ mod tests {
         assert_eq!(a.flip.errors, b.flip.errors);
         assert_eq!(a.metrics.relmse, b.metrics.relmse);
         assert_eq!(a.metrics.nonfinite, 2);
+    }
+
+    #[test]
+    fn a_non_finite_reference_pixel_is_left_out_of_flip() {
+        let test = image(12, 10, |x, y| 0.3 + 0.02 * ((x * 5 + y * 3) % 7) as f32);
+        let mut reference = image(12, 10, |_, _| 0.35);
+        reference.set(4, 5, Rgb::new(f32::NAN, 0.2, 0.1));
+        // What the rule means: the reference agrees with the test there, and the pixel
+        // is not averaged.
+        let mut agreeing = reference.clone();
+        agreeing.set(4, 5, test.get(4, 5));
+        let m = measure(&test, &reference, None, DEFAULT_PIXELS_PER_DEGREE).unwrap();
+        let a = measure(&test, &agreeing, None, DEFAULT_PIXELS_PER_DEGREE).unwrap();
+        assert_eq!(m.flip.error_at(4, 5), 0.0);
+        let others: Vec<f64> = (0..10)
+            .flat_map(|y| (0..12).map(move |x| (x, y)))
+            .filter(|&p| p != (4, 5))
+            .map(|(x, y)| f64::from(a.flip.error_at(x, y)))
+            .collect();
+        let mean = others.iter().sum::<f64>() / others.len() as f64;
+        assert!(
+            (m.flip_mean - mean).abs() < 1e-12,
+            "{} vs {mean}",
+            m.flip_mean
+        );
+        assert_eq!(m.flip.mean, m.flip_mean);
+        // A black stand-in would have made a difference of its own there.
+        let mut black = reference.clone();
+        black.set(4, 5, Rgb::new(0.0, 0.0, 0.0));
+        let b = measure(&test, &black, None, DEFAULT_PIXELS_PER_DEGREE).unwrap();
+        assert!(
+            b.flip_mean > m.flip_mean * 1.05,
+            "{} vs {}",
+            b.flip_mean,
+            m.flip_mean
+        );
+        let crop = Crop {
+            x0: 2,
+            y0: 3,
+            x1: 7,
+            y1: 8,
+        };
+        let c = measure(&test, &reference, Some(crop), DEFAULT_PIXELS_PER_DEGREE).unwrap();
+        let in_crop: Vec<f64> = (3..8)
+            .flat_map(|y| (2..7).map(move |x| (x, y)))
+            .filter(|&p| p != (4, 5))
+            .map(|(x, y)| f64::from(a.flip.error_at(x, y)))
+            .collect();
+        let crop_mean = in_crop.iter().sum::<f64>() / in_crop.len() as f64;
+        assert!((c.flip_mean - crop_mean).abs() < 1e-12);
     }
 
     #[test]
