@@ -70,12 +70,14 @@ fn ray_cast_matrix_1944_patches(bencher: Bencher) {
 fn hemicube_matrix_1944_patches(bencher: Bencher, resolution: usize) {
     let set = closed_box(MATRIX_DIVISIONS);
     let hemicube = HemiCube::new(resolution).expect("even resolution");
-    bencher.bench_local(|| hemicube.matrix(&set));
+    bencher.bench_local(|| hemicube.matrix(&set, &AlwaysVisible));
 }
 
 fn solver_input() -> (PatchSet, FormFactorMatrix<f64>) {
     let set = closed_box(MATRIX_DIVISIONS);
-    let f = HemiCube::new(64).expect("even resolution").matrix(&set);
+    let f = HemiCube::new(64)
+        .expect("even resolution")
+        .matrix(&set, &AlwaysVisible);
     (set, f)
 }
 

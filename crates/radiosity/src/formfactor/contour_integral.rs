@@ -44,9 +44,7 @@ pub fn point_polygon_factor(x: DVec3, n: DVec3, corners: &[DVec3], polygon_norma
     // about 2 and a diverging solve). Distinct faces that meet in a plane up to the
     // f32 rounding of their input (a box's bottom on the floor) are cut off as
     // contacts by the visibility instead (`visibility::contact`).
-    let offset = x - corners[0];
-    let scale = offset.length() + (corners[1] - corners[0]).length();
-    if offset.dot(polygon_normal) <= IN_PLANE * scale {
+    if !in_front_of(x, corners, polygon_normal) {
         return 0.0;
     }
     let mut contour = ContourSum::new(n);
@@ -69,6 +67,16 @@ pub fn point_polygon_factor(x: DVec3, n: DVec3, corners: &[DVec3], polygon_norma
         height_a = height_b;
     }
     (-contour.finish() / std::f64::consts::TAU).clamp(0.0, 1.0)
+}
+
+/// True when `x` lies in front of the plane of the polygon `corners` (at least three,
+/// facing `polygon_normal`) by more than rounding: heights under [`IN_PLANE`] of the
+/// configuration's size count as in the plane, so a point on a patch's back twin does
+/// not see its front.
+pub(crate) fn in_front_of(x: DVec3, corners: &[DVec3], polygon_normal: DVec3) -> bool {
+    let offset = x - corners[0];
+    let scale = offset.length() + (corners[1] - corners[0]).length();
+    offset.dot(polygon_normal) > IN_PLANE * scale
 }
 
 /// Running sum of `gamma_k n . c_k / |c_k|` over the edges of a vertex stream (vertices

@@ -21,9 +21,10 @@ use glam::DVec3;
 use rayon::prelude::*;
 use thiserror::Error;
 
-use super::contour_integral::point_polygon_factor;
+use super::contour_integral::{in_front_of, point_polygon_factor};
 use super::matrix::FormFactorMatrix;
 use crate::mesh::patch::{PatchSet, tangent_frame};
+use crate::visibility::Visibility;
 
 #[derive(Debug, Error, PartialEq)]
 pub enum HemiCubeError {
@@ -172,8 +173,11 @@ impl HemiCube {
             let patch = &set.patches[j];
             let polygon = set.polygon(j);
             let corners = polygon.as_slice();
-            // Back faces and patches in the eye's own plane are invisible.
-            if (x - corners[0]).dot(patch.normal) <= 0.0 {
+            // Back faces and patches in the eye's own plane are invisible. In the plane
+            // up to rounding counts: the back twin of a two-sided patch shares its
+            // corners, and at a height of 1e-13 its clipped outline covered the top
+            // face's cells, doubling the front's radiosity and shooting it through.
+            if !in_front_of(x, corners, patch.normal) {
                 continue;
             }
             let mut local = [DVec3::ZERO; 4];
@@ -218,20 +222,40 @@ impl HemiCube {
         }
     }
 
-    /// Row `from`: the hemi-cube at the centroid of patch `from`.
-    pub fn row(&self, set: &PatchSet, from: usize, buffers: &mut HemiCubeBuffers, out: &mut [f64]) {
+    /// Row `from`: the hemi-cube at the centroid of patch `from`. The depth buffer
+    /// resolves occlusion; pairs that `vis` says are [separated](Visibility::separated)
+    /// (a patch covered by a face resting on it) get no factor, as with ray-cast
+    /// factors. Without that, a covered patch's centroid, under the box resting on it,
+    /// would look into the box: with two-sided patches, its inner faces.
+    pub fn row(
+        &self,
+        set: &PatchSet,
+        from: usize,
+        vis: &impl Visibility,
+        buffers: &mut HemiCubeBuffers,
+        out: &mut [f64],
+    ) {
+        if vis.separated(from, from) {
+            out.fill(0.0);
+            return;
+        }
         let patch = &set.patches[from];
         self.point_factors(set, patch.centroid, patch.normal, Some(from), buffers, out);
+        for (j, f) in out.iter_mut().enumerate() {
+            if *f != 0.0 && vis.separated(from, j) {
+                *f = 0.0;
+            }
+        }
     }
 
     /// The full matrix, one hemi-cube per patch, rows in parallel (deterministic).
-    pub fn matrix(&self, set: &PatchSet) -> FormFactorMatrix<f64> {
+    pub fn matrix(&self, set: &PatchSet, vis: &impl Visibility) -> FormFactorMatrix<f64> {
         let n = set.len();
         let mut values = vec![0.0; n * n];
         if n > 0 {
             values.par_chunks_mut(n).enumerate().for_each_init(
                 || self.buffers(),
-                |buffers, (i, row)| self.row(set, i, buffers, row),
+                |buffers, (i, row)| self.row(set, i, vis, buffers, row),
             );
         }
         FormFactorMatrix::from_row_major(n, values).expect("n x n values")

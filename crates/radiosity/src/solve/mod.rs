@@ -571,7 +571,7 @@ fn factor_matrix<V: Visibility>(
             match &hemicube {
                 Some(h) => rows.par_chunks_mut(n).enumerate().for_each_init(
                     || h.buffers(),
-                    |buffers, (k, row)| h.row(set, first + k, buffers, row),
+                    |buffers, (k, row)| h.row(set, first + k, vis, buffers, row),
                 ),
                 None => rows
                     .par_chunks_mut(n)
@@ -622,7 +622,7 @@ pub fn enforce_closure(n: usize, values: &mut [f64]) -> ClosureReport {
 mod tests {
     use super::*;
     use crate::visibility::bvh::FaceVisibility;
-    use glam::Vec3;
+    use glam::{DVec3, Vec3};
     use radiant_scene::builtin::cornell_box;
     use radiant_scene::{FileLoc, ShapeDesc};
 
@@ -656,54 +656,102 @@ mod tests {
         RadiosityScene::from_desc(&desc, &settings).unwrap()
     }
 
+    /// Area-weighted mean radiosity (first band) of the patches facing into the room
+    /// from the walls, floor and ceiling.
+    fn room_mean(scene: &RadiosityScene, radiosity: &[[f64; 3]]) -> f64 {
+        let (mut sum, mut area) = (0.0, 0.0);
+        for (patch, b) in scene.patches.patches.iter().zip(radiosity) {
+            let towards_centre = (DVec3::splat(278.0) - patch.centroid).dot(patch.normal) > 0.0;
+            if towards_centre && patch.emission == [0.0; 3] {
+                sum += patch.area * b[0];
+                area += patch.area;
+            }
+        }
+        sum / area
+    }
+
     #[test]
     fn a_two_sided_box_with_a_cube_on_the_floor_stays_finite_and_closed() {
         let scene = box_with_a_cube_on_the_floor();
         let vis = FaceVisibility::new(&scene);
         // The floor under the cube and the cube's bottom cover each other.
         assert!(vis.covered_patches() > 0);
-        let settings = RadiositySettings {
-            max_patch_area: Some(2500.0),
-            two_sided: true,
-            tolerance: 1e-3,
-            ..RadiositySettings::default()
-        };
         let sphere = SceneSphere {
             center: Vec3::splat(278.0),
             radius: 500.0,
         };
-        let solution = solve(&scene, &[], sphere, &settings, &vis, |_| {
-            ControlFlow::Continue(())
-        })
-        .unwrap();
-        assert!(solution.converged);
-        let balance = solution.balance;
-        assert!(balance.failure().is_none(), "{}", balance.summary());
-        for b in 0..3 {
-            // Energy balance: emitted = absorbed + escaped + unshot, every share
-            // between 0 and the emitted power.
-            assert!(balance.imbalance()[b].abs() < 1e-9 * balance.emitted[b]);
-            for share in [balance.absorbed[b], balance.escaped[b], balance.unshot[b]] {
-                assert!((-1e-9..=1.0).contains(&(share / balance.emitted[b])));
+        let mut means = Vec::new();
+        for (form_factor, solver) in [
+            (FormFactorMethod::RayCast, SolverKind::Progressive),
+            (FormFactorMethod::HemiCube, SolverKind::Progressive),
+            (FormFactorMethod::HemiCube, SolverKind::GaussSeidel),
+        ] {
+            let case = format!("{form_factor:?} {solver:?}");
+            let settings = RadiositySettings {
+                max_patch_area: Some(2500.0),
+                two_sided: true,
+                tolerance: 1e-3,
+                form_factor,
+                solver,
+                ..RadiositySettings::default()
+            };
+            let solution = solve(&scene, &[], sphere, &settings, &vis, |_| {
+                ControlFlow::Continue(())
+            })
+            .unwrap();
+            assert!(solution.converged, "{case}");
+            let balance = solution.balance;
+            assert!(balance.failure().is_none(), "{case}: {}", balance.summary());
+            // Energy balance: emitted = absorbed + escaped + unshot, every share between 0
+            // and the emitted power. Shooting books every shot exactly; gathering with
+            // factors from patch centroids is only as reciprocal as they are.
+            let slack = match solver {
+                SolverKind::Progressive => 1e-9,
+                _ => 1e-2,
+            };
+            for b in 0..3 {
+                let imbalance = balance.imbalance()[b] / balance.emitted[b];
+                assert!(imbalance.abs() < slack, "{case}: {}", balance.summary());
+                for share in [balance.absorbed[b], balance.escaped[b], balance.unshot[b]] {
+                    assert!(
+                        (-1e-9..=1.0).contains(&(share / balance.emitted[b])),
+                        "{case}"
+                    );
+                }
             }
+            // Closure: no row of factors came out above 1 by more than the centroid
+            // estimate's error next to small neighbours (a patch coupled to its own
+            // back side, or one seeing through a face lying on it, sums to about 2).
+            assert!(
+                solution.closure.largest_row_sum < 1.5,
+                "{case}: {:?}",
+                solution.closure
+            );
+            // No light reaches the inside of the closed cube, nor the floor under it:
+            // a patch's back twin, in its plane up to rounding, sees none of its front.
+            let lit = solution.radiosity.iter().map(|b| b[0]).fold(0.0, f64::max);
+            for (patch, b) in scene.patches.patches.iter().zip(&solution.radiosity) {
+                let c = patch.centroid;
+                let inside =
+                    (380.5..479.5).contains(&c.x) && (60.5..159.5).contains(&c.z) && c.y < 99.5;
+                if inside {
+                    assert!(
+                        b[0] < 1e-9 * lit,
+                        "{case}: {c:?} {:?} {lit}: {b:?}",
+                        patch.normal
+                    );
+                }
+            }
+            means.push((case, room_mean(&scene, &solution.radiosity)));
         }
-        // Closure: no shooter's row of factors came out above 1 by more than the
-        // centroid estimate's error next to small neighbours (a patch coupled to its
-        // own back side, or one seeing through a face lying on it, sums to about 2).
-        assert!(
-            solution.closure.largest_row_sum < 1.5,
-            "{:?}",
-            solution.closure
-        );
-        // No light reaches the inside of the closed cube, nor the floor under it.
-        let lit = solution.radiosity.iter().map(|b| b[0]).fold(0.0, f64::max);
-        for (patch, b) in scene.patches.patches.iter().zip(&solution.radiosity) {
-            let c = patch.centroid;
-            let inside =
-                (380.5..479.5).contains(&c.x) && (60.5..159.5).contains(&c.z) && c.y < 99.5;
-            if inside {
-                assert!(b[0] < 1e-9 * lit, "{c:?} {:?} {lit}: {b:?}", patch.normal);
-            }
+        // The methods agree on the room's light (they differ by their discretisation:
+        // 0.1 % here; a hemi-cube that saw the back twins lost 5 %).
+        let (_, reference) = &means[0];
+        for (case, mean) in &means {
+            assert!(
+                (mean / reference - 1.0).abs() < 0.01,
+                "{case}: {mean} against ray-cast {reference}"
+            );
         }
     }
 

@@ -467,7 +467,7 @@ impl<V: Visibility> Shooting<'_, V> {
         if let (ShootingFactors::HemiCube(h), Some(buffers)) =
             (factors, self.hemicube_buffers.as_mut())
         {
-            h.row(set, i, buffers, &mut self.hemicube_row);
+            h.row(set, i, self.vis, buffers, &mut self.hemicube_row);
         }
         if self.cull {
             let total = set.len();

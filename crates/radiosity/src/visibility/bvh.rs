@@ -222,6 +222,10 @@ impl Visibility for FaceVisibility {
         self.occluders == 0 && self.contacts.covered() == 0
     }
 
+    fn separated(&self, a: usize, b: usize) -> bool {
+        self.contacts.separated(a, b)
+    }
+
     fn prepare_shot(
         &self,
         set: &PatchSet,
@@ -302,6 +306,13 @@ impl Visibility for SceneVisibility<'_> {
         match self {
             SceneVisibility::Faces(v) => v.always_visible(),
             SceneVisibility::World(v) => v.always_visible(),
+        }
+    }
+
+    fn separated(&self, a: usize, b: usize) -> bool {
+        match self {
+            SceneVisibility::Faces(v) => v.separated(a, b),
+            SceneVisibility::World(v) => v.separated(a, b),
         }
     }
 

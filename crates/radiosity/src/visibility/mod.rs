@@ -26,6 +26,14 @@ pub trait Visibility: Sync {
         false
     }
 
+    /// True when patches `a` and `b` exchange no light at all, whatever the points:
+    /// one of them is covered by a face lying on it (see [`contact`]). Form factors
+    /// that resolve occlusion without this trait (the hemi-cube's depth buffer) ask
+    /// this, so that every method treats surfaces in contact alike. The default: never.
+    fn separated(&self, _a: usize, _b: usize) -> bool {
+        false
+    }
+
     /// Optional speed-up for the many queries of one progressive shot (rays between
     /// patch `source` and every receiver): prepares `shot` (e.g. the occluders that can
     /// matter per group of receivers). The default prepares nothing.
@@ -69,6 +77,10 @@ impl<V: Visibility> Visibility for InShot<'_, V> {
 
     fn always_visible(&self) -> bool {
         self.vis.always_visible()
+    }
+
+    fn separated(&self, a: usize, b: usize) -> bool {
+        self.vis.separated(a, b)
     }
 }
 

@@ -3,7 +3,7 @@
 
 use radiant_math::DVec3;
 use radiant_radiosity::mesh::patch::equal_area_disk_polygon;
-use radiant_radiosity::{HemiCube, PatchSet, point_polygon_factor};
+use radiant_radiosity::{AlwaysVisible, HemiCube, PatchSet, point_polygon_factor};
 use serde_json::Value;
 
 use crate::common::{shared_json, vec3, vertices};
@@ -173,7 +173,7 @@ fn hemicube_patch_rows_show_the_proximity_error_of_the_table() {
         let res = row["res"].as_u64().unwrap() as usize;
         let hemicube = HemiCube::new(res).unwrap();
         let mut out = vec![0.0; 2];
-        hemicube.row(&set, 0, &mut hemicube.buffers(), &mut out);
+        hemicube.row(&set, 0, &AlwaysVisible, &mut hemicube.buffers(), &mut out);
         let at_centre = row["exact_point_at_centre"].as_f64().unwrap();
         let area = row["exact_area"].as_f64().unwrap();
         let theirs = row["hemicube"].as_f64().unwrap() - at_centre;
@@ -305,5 +305,53 @@ fn tilted_triangles_converge_with_resolution() {
         assert!(worst < 2.0 / res as f64);
         assert!(worst < previous_worst);
         previous_worst = worst;
+    }
+}
+
+#[test]
+fn a_patch_and_its_back_twin_see_nothing_of_each_other() {
+    // A two-sided patch is two patches with the same corners, one reversed. The
+    // centroid of one lies in the other's plane only up to rounding; a height of 1e-13
+    // in front of it made the hemi-cube project the twin across the top face, giving a
+    // factor near 1 between the two sides of one surface. Quads in tilted planes, seen
+    // with a facing quad above them (whose factor must survive).
+    let hemicube = HemiCube::new(64).unwrap();
+    let mut buffers = hemicube.buffers();
+    for k in 0..64 {
+        let (a, b) = (0.37 * k as f64, 0.11 + 0.23 * k as f64);
+        let u = DVec3::new(a.cos(), a.sin() * b.cos(), a.sin() * b.sin());
+        let v = u.any_orthonormal_vector();
+        let n = u.cross(v);
+        let origin = DVec3::new(0.1 * k as f64, 3.7, -1.3) * 17.0;
+        let quad = |lift: f64, flip: bool| {
+            let base = origin + n * lift;
+            let mut c = vec![
+                base,
+                base + u * 3.0,
+                base + u * 3.0 + v * 2.0,
+                base + v * 2.0,
+            ];
+            if flip {
+                c.reverse();
+            }
+            c
+        };
+        let mut set = PatchSet::new();
+        set.add_polygon(&quad(0.0, false), [0.0; 3], [0.5; 3])
+            .unwrap();
+        set.add_polygon(&quad(0.0, true), [0.0; 3], [0.5; 3])
+            .unwrap();
+        set.add_polygon(&quad(1.0, true), [0.0; 3], [0.5; 3])
+            .unwrap();
+        let mut out = vec![0.0; 3];
+        hemicube.row(&set, 0, &AlwaysVisible, &mut buffers, &mut out);
+        assert_eq!(out[1], 0.0, "case {k}: front to back {out:?}");
+        assert!(out[2] > 0.3, "case {k}: {out:?}");
+        hemicube.row(&set, 1, &AlwaysVisible, &mut buffers, &mut out);
+        assert_eq!(out[0], 0.0, "case {k}: back to front {out:?}");
+        assert_eq!(
+            out[2], 0.0,
+            "case {k}: the back sees nothing above: {out:?}"
+        );
     }
 }

@@ -67,7 +67,7 @@ fn closed_cube_rows_sum_to_one_and_factors_are_reciprocal() {
         assert!(closure_error(&f) < 1e-13);
         assert!(r.max_relative < reciprocity_bound, "{r:?}");
     }
-    let hemicube = HemiCube::new(64).unwrap().matrix(&set);
+    let hemicube = HemiCube::new(64).unwrap().matrix(&set, &AlwaysVisible);
     let r = reciprocity(&set, &hemicube);
     println!(
         "hemi-cube 64: closure {:.1e}, reciprocity {:.1e}",
@@ -105,7 +105,7 @@ fn occluded_rows_still_close() {
     let worst = sums.iter().map(|s| (s - 1.0).abs()).fold(0.0, f64::max);
     println!("ray cast with blocker: closure error {worst:.1e}");
     assert!(worst < 0.05);
-    let h = HemiCube::new(64).unwrap().matrix(&set);
+    let h = HemiCube::new(64).unwrap().matrix(&set, &AlwaysVisible);
     assert!(closure_error(&h) < 1e-12);
     // The floor patch right under the blocker sees it, not the ceiling above.
     let floor_centre = (0..9)
@@ -161,7 +161,7 @@ fn shooting_with_hemicubes_matches_shooting_with_their_matrix() {
     // the same to rounding.
     let set = small_box();
     let hemicube = HemiCube::new(32).unwrap();
-    let f = hemicube.matrix(&set);
+    let f = hemicube.matrix(&set, &AlwaysVisible);
     let settings = ProgressiveSettings {
         unshot_tolerance: 1e-3,
         ..ProgressiveSettings::default()
@@ -193,7 +193,7 @@ fn the_two_factor_methods_agree_on_the_solution() {
     // neighbouring patches but partly averages out in B; measured 3 % apart.
     let set = small_box();
     let ray = RayCaster::new(RayCastSettings::default()).matrix(&set, &AlwaysVisible);
-    let hemi = HemiCube::new(128).unwrap().matrix(&set);
+    let hemi = HemiCube::new(128).unwrap().matrix(&set, &AlwaysVisible);
     let b_ray = solve_gauss_seidel(&set, &ray, TIGHT, |_, _| {})
         .unwrap()
         .radiosity;
