@@ -10,33 +10,11 @@ use std::time::Duration;
 
 use radiant::image::read_image;
 
-const BIN: &str = env!("CARGO_BIN_EXE_radiant");
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("radiant-ckpt-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod common;
+use common::*;
 
 fn run(args: &[&str], extra: &[&Path]) -> Output {
     Command::new(BIN).args(args).args(extra).output().unwrap()
-}
-
-fn stderr_of(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn assert_ok(out: &Output, what: &str) {
-    assert!(out.status.success(), "{what}: {}", stderr_of(out));
-}
-
-/// A handled error (exit status 1, no panic); returns its message.
-fn assert_refused(out: &Output, what: &str) -> String {
-    let stderr = stderr_of(out);
-    assert_eq!(out.status.code(), Some(1), "{what}: {stderr}");
-    assert!(!stderr.contains("panicked"), "{what} panicked: {stderr}");
-    stderr
 }
 
 /// The image's pixels as f32 bit patterns (headers left out).
@@ -91,7 +69,7 @@ fn stop_and_resume_as(
         &with(args, &["--threads", "1", "--stop-after", &stop, "-o"]),
         &[&partial, Path::new("--checkpoint"), &ckpt],
     );
-    let stderr = assert_refused(&out, name);
+    let stderr = assert_clean_failure(&out, name);
     assert!(
         stderr.contains(&ckpt.display().to_string()),
         "{name}: {stderr}"
@@ -203,12 +181,12 @@ fn adaptive_renders_resume_bit_identically_in_the_pilot_and_after_it() {
         &[&plain[..], &["--stop-after", "4", "-o"]].concat(),
         &[&dir.join("u.pfm"), Path::new("--checkpoint"), &uniform],
     );
-    assert_refused(&out, "uniform stopped");
+    assert_clean_failure(&out, "uniform stopped");
     let out = run(
         &[&args[..], &["-o"]].concat(),
         &[&dir.join("u2.pfm"), Path::new("--resume"), &uniform],
     );
-    let e = assert_refused(&out, "uniform checkpoint resumed adaptively");
+    let e = assert_clean_failure(&out, "uniform checkpoint resumed adaptively");
     assert!(
         e.contains("uniform sampling in the checkpoint, adaptive now"),
         "{e}"
@@ -251,13 +229,13 @@ fn progressive_radiosity_resumes_bit_identically() {
         &[&args[..], &["--refine", "1", "--checkpoint"]].concat(),
         &[&dir.join("r.ckpt")],
     );
-    let stderr = assert_refused(&out, "radiosity --refine");
+    let stderr = assert_clean_failure(&out, "radiosity --refine");
     assert!(stderr.contains("--refine"), "{stderr}");
     let out = run(
         &[&args[..], &["--solver", "jacobi", "--checkpoint"]].concat(),
         &[&dir.join("r.ckpt")],
     );
-    let stderr = assert_refused(&out, "radiosity --solver jacobi");
+    let stderr = assert_clean_failure(&out, "radiosity --solver jacobi");
     assert!(stderr.contains("progressive"), "{stderr}");
 }
 
@@ -337,9 +315,9 @@ fn other_runs_truncated_and_corrupt_checkpoints_are_refused() {
             &[&dir.join("x.pfm"), Path::new("--resume"), file],
         )
     };
-    let e = assert_refused(&resume(&["--seed", "5"], &ckpt), "other seed");
+    let e = assert_clean_failure(&resume(&["--seed", "5"], &ckpt), "other seed");
     assert!(e.contains("seed 0 in the checkpoint, 5 now"), "{e}");
-    let e = assert_refused(&resume(&["cornell-caustics"], &ckpt), "other scene");
+    let e = assert_clean_failure(&resume(&["cornell-caustics"], &ckpt), "other scene");
     assert!(e.contains("the scene differs"), "{e}");
     let out = run(
         &[
@@ -353,29 +331,29 @@ fn other_runs_truncated_and_corrupt_checkpoints_are_refused() {
         ],
         &[&dir.join("x.pfm"), Path::new("--resume"), &ckpt],
     );
-    let e = assert_refused(&out, "other size");
+    let e = assert_clean_failure(&out, "other size");
     assert!(
         e.contains("resolution 12x12 in the checkpoint, 12x10 now"),
         "{e}"
     );
-    let e = assert_refused(&resume(&["--integrator", "sppm"], &ckpt), "other method");
+    let e = assert_clean_failure(&resume(&["--integrator", "sppm"], &ckpt), "other method");
     assert!(e.contains("integrator \"path\" in the checkpoint"), "{e}");
 
     let bytes = std::fs::read(&ckpt).unwrap();
     let truncated = dir.join("truncated.ckpt");
     std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
-    let e = assert_refused(&resume(&[], &truncated), "truncated");
+    let e = assert_clean_failure(&resume(&[], &truncated), "truncated");
     assert!(e.contains("truncated"), "{e}");
     let corrupt = dir.join("corrupt.ckpt");
     let mut flipped = bytes.clone();
     let mid = flipped.len() / 2;
     flipped[mid] ^= 1;
     std::fs::write(&corrupt, &flipped).unwrap();
-    let e = assert_refused(&resume(&[], &corrupt), "corrupt");
+    let e = assert_clean_failure(&resume(&[], &corrupt), "corrupt");
     assert!(e.contains("checksum"), "{e}");
-    let e = assert_refused(&resume(&[], &image), "an image");
+    let e = assert_clean_failure(&resume(&[], &image), "an image");
     assert!(e.contains("not a radiant checkpoint"), "{e}");
-    let e = assert_refused(&resume(&[], &dir.join("missing.ckpt")), "missing");
+    let e = assert_clean_failure(&resume(&[], &dir.join("missing.ckpt")), "missing");
     assert!(e.contains("cannot read the checkpoint"), "{e}");
     // The image the refused runs would have written was never started.
     assert!(!dir.join("x.pfm").exists());
@@ -390,6 +368,6 @@ fn other_runs_truncated_and_corrupt_checkpoints_are_refused() {
         "{e}"
     );
     let out = run(&["render", "--stop-after", "2"], &[]);
-    let e = assert_refused(&out, "--stop-after alone");
+    let e = assert_clean_failure(&out, "--stop-after alone");
     assert!(e.contains("--checkpoint"), "{e}");
 }

@@ -1,31 +1,15 @@
 //! The command line end to end: renders, bad input, determinism across thread counts,
 //! and Ctrl-C writing the image rendered so far.
 
-use std::path::PathBuf;
 use std::process::{Command, Output};
 
 use radiant::image::read_image;
 
-fn radiant() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_radiant"))
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("radiant-cli-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod common;
+use common::*;
 
 fn run(cmd: &mut Command) -> Output {
     cmd.output().expect("radiant runs")
-}
-
-/// A panic exits with 101 and prints "panicked"; a handled error exits with 1.
-fn assert_clean_failure(out: &Output, what: &str) -> String {
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(out.status.code(), Some(1), "{what}: {stderr}");
-    assert!(!stderr.contains("panicked"), "{what} panicked: {stderr}");
-    stderr
 }
 
 #[test]

@@ -2,30 +2,15 @@
 //! the flags, partial files, `radiant merge`, and a radiosity solution solved once and
 //! displayed in parts — merged images bit for bit the one-machine render's.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
 use radiant::image::read_image;
 
-const BIN: &str = env!("CARGO_BIN_EXE_radiant");
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("radiant-dist-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn radiant(dir: &Path, args: &[&str]) -> Output {
-    Command::new(BIN)
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("runs")
-}
+mod common;
+use common::*;
 
 fn ok(dir: &Path, args: &[&str]) {
-    let out = radiant(dir, args);
+    let out = radiant_in(dir, args);
     assert!(
         out.status.success(),
         "radiant {}: {}",
@@ -35,7 +20,7 @@ fn ok(dir: &Path, args: &[&str]) {
 }
 
 fn failure(dir: &Path, args: &[&str]) -> String {
-    let out = radiant(dir, args);
+    let out = radiant_in(dir, args);
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert_eq!(
         out.status.code(),

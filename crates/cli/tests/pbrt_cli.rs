@@ -12,15 +12,8 @@ use std::time::Duration;
 use radiant::image::read_image;
 use radiant_report::tev::Packet;
 
-fn radiant() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_radiant"))
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("radiant-pbrt-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod common;
+use common::*;
 
 fn ok(cmd: &mut Command) -> Output {
     let out = cmd.output().expect("radiant runs");

@@ -10,30 +10,8 @@ use std::time::Duration;
 use radiant::image::exr::read_exr_attributes;
 use radiant::image::read_image;
 
-const BIN: &str = env!("CARGO_BIN_EXE_radiant");
-
-fn radiant() -> Command {
-    Command::new(BIN)
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("radiant-rel-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn stderr_of(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-/// A handled error: exit status 1, no panic.
-fn assert_clean_failure(out: &Output, what: &str) -> String {
-    let stderr = stderr_of(out);
-    assert_eq!(out.status.code(), Some(1), "{what}: {stderr}");
-    assert!(!stderr.contains("panicked"), "{what} panicked: {stderr}");
-    stderr
-}
+mod common;
+use common::*;
 
 /// Files in `dir` whose names mark an unfinished write.
 fn temporaries(dir: &Path) -> Vec<String> {

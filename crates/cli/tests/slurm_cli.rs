@@ -2,28 +2,14 @@
 //! is written, values cannot add lines or words to the job scripts, and a failed run
 //! leaves no folders behind.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Command;
 
-const BIN: &str = env!("CARGO_BIN_EXE_radiant");
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("radiant-slurm-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn radiant(dir: &Path, args: &[&str]) -> Output {
-    Command::new(BIN)
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("runs")
-}
+mod common;
+use common::*;
 
 fn failure(dir: &Path, args: &[&str]) -> String {
-    let out = radiant(dir, args);
+    let out = radiant_in(dir, args);
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
     assert!(
         !out.status.success(),
@@ -87,7 +73,7 @@ fn jobs_every_task_would_refuse_are_refused_up_front() {
     assert!(e.contains("unknown integrator"), "{e}");
     assert_eq!(entries(&d), Vec::<String>::new(), "nothing is written");
     // What the tasks take is written.
-    let out = radiant(&d, &job(&["--parts", "6"]));
+    let out = radiant_in(&d, &job(&["--parts", "6"]));
     assert!(
         out.status.success(),
         "{}",
@@ -123,7 +109,7 @@ fn values_cannot_add_lines_or_words_to_the_scripts() {
 
     // Blanks, quotes and `#` stay inside one word of each script.
     std::fs::create_dir(d.join("a b")).unwrap();
-    let out = radiant(
+    let out = radiant_in(
         &d,
         &run(&[
             "-o",

@@ -12,6 +12,9 @@ use std::time::{Duration, Instant};
 
 use serde_json::Value;
 
+mod common;
+use common::*;
+
 fn radiant(args: &[&str]) -> (String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_radiant"))
         .args(args)
@@ -24,13 +27,6 @@ fn radiant(args: &[&str]) -> (String, String) {
     );
     assert!(out.status.success(), "radiant {args:?} failed:\n{stderr}");
     (stdout, stderr)
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("study-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 fn s(p: &Path) -> &str {
