@@ -211,6 +211,12 @@ impl FaceVisibility {
         self.occluders
     }
 
+    /// Whether progressive shots are shaft-culled; where culling would cost more than
+    /// it saves (see [`ShaftCuller::pays`]), every shadow ray goes through the BVH.
+    pub fn culls_shots(&self) -> bool {
+        self.shafts.pays()
+    }
+
     /// Whether anything blocks `ray` before `t_max`.
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.bvh.occluded(ray, t_max)
@@ -235,6 +241,10 @@ impl Visibility for FaceVisibility {
     ) -> bool {
         // Receivers that exchange light with the shooter lie in front of it, so every
         // ray of the shot ends at its centroid lifted along its normal.
+        if !self.culls_shots() {
+            // Left unprepared: every ray of the shot goes through the BVH.
+            return true;
+        }
         let apex = set.patches[source].centroid + self.lifts[source].as_dvec3();
         self.shafts.prepare(source, apex, self.lift, shot, go_on)
     }

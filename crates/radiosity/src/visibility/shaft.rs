@@ -76,6 +76,11 @@ fn bounding_sphere(points: &[DVec3]) -> (DVec3, f64) {
 /// milliseconds).
 const TILE_BLOCK_WORK: usize = 1 << 22;
 
+/// Tile-occluder tests per patch above which a shot's preparation costs more than the
+/// BVH's shadow rays it would save: a shot casts a few rays per patch at about a
+/// microsecond each, and a tile-occluder test costs a few nanoseconds.
+const TESTS_PER_PATCH: usize = 64;
+
 /// Occluders and receiver tiles.
 #[derive(Clone, Debug, Default)]
 pub struct ShaftCuller {
@@ -141,6 +146,16 @@ impl ShaftCuller {
             tile_of,
             tolerance,
         }
+    }
+
+    /// Whether culling pays: the tile-occluder tests of a shot's preparation grow as
+    /// tiles × occluders, quadratically in the input meshes (a tile never spans two
+    /// input faces), which on a scanned or subdivided mesh of 10⁵ triangles is 10¹⁰
+    /// tests, seconds per shot. Past [`TESTS_PER_PATCH`] tests per patch, shots use the
+    /// BVH's shadow rays instead.
+    pub fn pays(&self) -> bool {
+        self.tiles.len().saturating_mul(self.occluders.len())
+            <= TESTS_PER_PATCH.saturating_mul(self.tile_of.len())
     }
 
     /// Fills `shot` with the candidate occluders of every tile for rays from receivers

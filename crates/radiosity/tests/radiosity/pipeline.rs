@@ -91,6 +91,80 @@ fn shaft_culled_face_visibility_agrees_with_the_world_bvh() {
 }
 
 #[test]
+fn shots_that_culling_would_slow_use_the_bvh_and_agree_with_the_world() {
+    // Culling a shot tests every receiver tile against every occluder, and a tile
+    // never spans two input faces: on a finely tessellated mesh that is quadratic in
+    // its triangles (seconds per shot on Bitterli's material-testball, 130k patches).
+    // A corrugated plate of 48 x 48 small quads (4,608 occluding triangles) hung in the
+    // Cornell box is past that budget; its shots must then go through the face BVH and
+    // agree with the render world's BVH as the culled ones do on the plain box.
+    let (_, plain, plain_world) = cornell(4000.0);
+    assert!(FaceVisibility::new(&plain).culls_shots());
+
+    let mut desc = cornell_box();
+    let material = desc.shapes[0].material;
+    let n = 48;
+    let (x0, z0, size) = (130.0f32, 130.0f32, 300.0f32);
+    let cell = size / n as f32;
+    let height = |i: usize, k: usize| 380.0 + if (i + k).is_multiple_of(2) { 0.0 } else { 4.0 };
+    let mut quads = Vec::new();
+    for i in 0..n {
+        for k in 0..n {
+            let (x, z) = (x0 + i as f32 * cell, z0 + k as f32 * cell);
+            // Facing down, towards the floor: counter-clockwise seen from below.
+            quads.push([
+                Vec3::new(x, height(i, k), z),
+                Vec3::new(x + cell, height(i + 1, k), z),
+                Vec3::new(x + cell, height(i + 1, k + 1), z + cell),
+                Vec3::new(x, height(i, k + 1), z + cell),
+            ]);
+        }
+    }
+    desc.shapes
+        .push(ShapeDesc::quads(&quads, material, FileLoc::builtin("test")));
+    let settings = RadiositySettings {
+        tolerance: 1e-3,
+        ..settings_with_area(4000.0)
+    };
+    let scene = RadiosityScene::from_desc(&desc, &settings).unwrap();
+    let (world, _) = World::build(&desc).unwrap();
+    let faces = FaceVisibility::new(&scene);
+    assert!(faces.occluder_count() > 4_000);
+    assert!(!faces.culls_shots());
+    let render = WorldVisibility::new(&world, &scene.patches);
+    let with_faces = solve_to_end(&scene, &world, &settings, &faces);
+    let with_world = solve_to_end(&scene, &world, &settings, &render);
+    assert!(with_faces.converged && with_world.converged);
+    let difference = max_relative_difference(&with_faces.radiosity, &with_world.radiosity);
+    eprintln!("radiosities differ by {difference:e}");
+    assert!(difference < 1e-3);
+    // The plate shades the floor under it.
+    let plain_solution = solve_to_end(
+        &plain,
+        &plain_world,
+        &settings,
+        &FaceVisibility::new(&plain),
+    );
+    assert!(
+        floor_under_the_plate(&scene, &with_faces)
+            < 0.5 * floor_under_the_plate(&plain, &plain_solution)
+    );
+}
+
+/// Mean radiosity (green) of the floor patches under the middle of the box.
+fn floor_under_the_plate(scene: &RadiosityScene, solution: &Solution) -> f64 {
+    let (mut sum, mut area) = (0.0, 0.0);
+    for (p, b) in scene.patches.patches.iter().zip(&solution.radiosity) {
+        let c = p.centroid;
+        if c.y < 1.0 && (180.0..380.0).contains(&c.x) && (180.0..380.0).contains(&c.z) {
+            sum += p.area * b[1];
+            area += p.area;
+        }
+    }
+    sum / area
+}
+
+#[test]
 fn factor_methods_and_solvers_agree_on_the_cornell_box() {
     // Progressive ray casting (one point per receiver) to 1e-4, Gauss-Seidel on the
     // ray-cast matrix (2 x 2 points per receiver), and progressive hemi-cube shooting
