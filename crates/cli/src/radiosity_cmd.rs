@@ -15,7 +15,7 @@ use radiant::radiosity::integrator::solve_session_resumed;
 use radiant::radiosity::output::export::{LitMesh, write_lit_mesh, write_patch_csv, write_ply};
 use radiant::radiosity::output::shading::Shading;
 use radiant::radiosity::settings::RadiositySettings;
-use radiant::radiosity::solve::SolveEvent;
+use radiant::radiosity::solve::{EscapeContext, SolveEvent};
 use radiant::render::integrator::render_passes;
 use radiant::render::{Overrides, Progress, RenderContext, RenderControl};
 use radiant::scene::{FileLoc, Param, ParamValue};
@@ -465,7 +465,7 @@ pub fn run(args: RadiosityArgs) -> anyhow::Result<()> {
     out!("{}", solution.balance.summary());
     if let Some(warning) = solution
         .balance
-        .escape_warning()
+        .escape_warning(EscapeContext::of(settings, &ctx.world.lights))
         .filter(|_| !solution.interrupted)
     {
         eprintln!("warning: {warning}");

@@ -436,7 +436,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .stats
         .get::<radiant::radiosity::solve::RadiosityStats>()
         .filter(|_| !output_data.interrupted)
-        .and_then(|s| s.balance.escape_warning())
+        .and_then(|s| s.balance.escape_warning(s.escape))
     {
         eprintln!("warning: {warning}");
     }

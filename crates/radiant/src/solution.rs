@@ -14,7 +14,7 @@ use std::time::Instant;
 use radiant_image::atomic::atomic_write;
 use radiant_radiosity::mesh::meshed_scene::RadiosityScene;
 use radiant_radiosity::output::shading::Shading;
-use radiant_radiosity::solve::{PowerBalance, RadiosityStats, Solution};
+use radiant_radiosity::solve::{EscapeContext, PowerBalance, RadiosityStats, Solution};
 use radiant_radiosity::{PatchSet, RadiosityIntegrator};
 use radiant_render::RenderContext;
 use radiant_render::integrator::{Integrator, RenderControl, RenderOutput, Stats, render_passes};
@@ -175,6 +175,7 @@ impl Integrator for SolvedRadiosity {
         out.seconds = start.elapsed().as_secs_f64();
         out.stats = Stats::new(RadiosityStats {
             patches: scene.patches.len(),
+            escape: EscapeContext::of(settings, &ctx.world.lights),
             iterations: self.solution.iterations,
             converged: self.solution.converged,
             solve_seconds: 0.0,

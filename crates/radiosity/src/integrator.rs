@@ -11,7 +11,7 @@ use crate::output::shading::Shading;
 use crate::settings::{RadiositySettings, VisibilitySource};
 use crate::solve::adaptive::{AdaptiveSolution, solve_adaptive_from};
 use crate::solve::progressive::ProgressiveState;
-use crate::solve::{RadiosityError, RadiosityStats, SolveEvent};
+use crate::solve::{EscapeContext, RadiosityError, RadiosityStats, SolveEvent};
 use crate::visibility::bvh::{FaceVisibility, SceneVisibility, WorldVisibility};
 use radiant_render::integrator::{Integrator, RenderControl, RenderOutput, Stats, render_passes};
 use radiant_render::world::World;
@@ -86,6 +86,7 @@ impl Integrator for RadiosityIntegrator {
         out.seconds = start.elapsed().as_secs_f64();
         out.stats = Stats::new(RadiosityStats {
             patches: scene.patches.len(),
+            escape: EscapeContext::of(settings, &ctx.world.lights),
             iterations: solution.iterations,
             converged: solution.converged,
             solve_seconds: solution.seconds,

@@ -57,6 +57,26 @@ pub enum RadiosityError {
 
 /// Power per band (W, or the scene's units of power): what the lights send, where it
 /// went, and what the solver had not yet distributed when it stopped.
+/// What a scene's escaping power says about it (see [`PowerBalance::escape_warning`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct EscapeContext {
+    /// Patches were meshed on both sides of surfaces.
+    pub two_sided: bool,
+    /// An infinite or distant light shines in from outside the scene.
+    pub lit_from_outside: bool,
+}
+
+impl EscapeContext {
+    pub fn of(settings: &RadiositySettings, lights: &[Light]) -> EscapeContext {
+        EscapeContext {
+            two_sided: settings.two_sided,
+            lit_from_outside: lights
+                .iter()
+                .any(|l| matches!(l, Light::Infinite { .. } | Light::Distant { .. })),
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PowerBalance {
     pub emitted: [f64; 3],
@@ -108,13 +128,22 @@ impl PowerBalance {
     /// A warning when more than half of the emitted power (summed over bands) left the
     /// scene without reaching a patch: usually surfaces facing away from the light
     /// (one-sided patches of a scene wound the other way) rather than an open scene.
-    pub fn escape_warning(&self) -> Option<String> {
+    /// None for scenes lit from outside, whose lights' power is their flux through a
+    /// disk covering the whole scene, most of which misses its surfaces by design.
+    pub fn escape_warning(&self, scene: EscapeContext) -> Option<String> {
         let emitted: f64 = self.emitted.iter().sum();
         let escaped: f64 = self.escaped.iter().sum();
-        (emitted > 0.0 && escaped > 0.5 * emitted).then(|| {
+        let share = 100.0 * escaped / emitted;
+        if scene.lit_from_outside || !(emitted > 0.0 && escaped > 0.5 * emitted) {
+            return None;
+        }
+        Some(if scene.two_sided {
             format!(
-                "radiosity: {:.0} % of the emitted power escaped without reaching a patch; if the scene is closed, its surfaces may face away from the light (try \"bool twosided\" true)",
-                100.0 * escaped / emitted
+                "radiosity: {share:.0} % of the emitted power escaped without reaching a patch: the scene is open where its lights shine"
+            )
+        } else {
+            format!(
+                "radiosity: {share:.0} % of the emitted power escaped without reaching a patch; if the scene is closed, its surfaces may face away from the light (try \"bool twosided\" true)"
             )
         })
     }
@@ -142,6 +171,8 @@ impl PowerBalance {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RadiosityStats {
     pub patches: usize,
+    /// What the balance's escaping power means for this scene.
+    pub escape: EscapeContext,
     /// Shots (progressive) or sweeps (matrix solvers).
     pub iterations: usize,
     pub converged: bool,
@@ -778,7 +809,8 @@ mod tests {
             unshot: [0.0; 3],
         };
         assert!(ok.failure().is_none());
-        assert!(ok.escape_warning().is_none());
+        let inside = EscapeContext::default();
+        assert!(ok.escape_warning(inside).is_none());
         let nan = PowerBalance {
             absorbed: [f64::NAN, 0.6, 0.6],
             ..ok
@@ -795,6 +827,25 @@ mod tests {
             escaped: [0.88; 3],
             ..ok
         };
-        assert!(open.escape_warning().unwrap().contains("88 %"));
+        let warning = open.escape_warning(inside).unwrap();
+        assert!(
+            warning.contains("88 %") && warning.contains("twosided"),
+            "{warning}"
+        );
+        let two_sided = EscapeContext {
+            two_sided: true,
+            ..inside
+        };
+        let warning = open.escape_warning(two_sided).unwrap();
+        assert!(
+            warning.contains("88 %") && !warning.contains("twosided"),
+            "{warning}"
+        );
+        // An environment's power is its flux through a disk covering the scene.
+        let outside = EscapeContext {
+            lit_from_outside: true,
+            ..two_sided
+        };
+        assert!(open.escape_warning(outside).is_none());
     }
 }
