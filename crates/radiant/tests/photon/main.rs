@@ -6,6 +6,7 @@
 
 #[path = "../common/mod.rs"]
 mod common;
+mod glossy_points;
 mod maps;
 mod photonmap;
 mod rough_glass;

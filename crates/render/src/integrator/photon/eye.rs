@@ -11,7 +11,9 @@ use super::settings::Visualize;
 use super::{PhotonMaps, facing};
 use crate::geometry::Ray;
 use crate::integrator::direct::{ShadingPoint, sample_direct, sides_agree};
-use crate::integrator::specular::{ChainVertex, chain_bounce, glossy_direct, specular_bounce};
+use crate::integrator::specular::{
+    ChainVertex, chain_bounce, direct_with_bsdf_sample, glossy_direct, specular_bounce,
+};
 use crate::light::SceneSphere;
 use crate::material::{Material, TransportMode};
 use crate::sampler::PixelSample;
@@ -129,11 +131,27 @@ pub fn radiance(
         let reflected = match settings.visualize {
             Visualize::None => {
                 l += beta * emitted;
-                let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
-                let u_light = sampler.get_2d();
+                let direct = if material.is_diffuse() {
+                    let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
+                    let u_light = sampler.get_2d();
+                    let at = ShadingPoint::new(&hit, material, wo_world);
+                    let direct = sample_direct(world, ctx.scene, &at, u_choice, u_light);
+                    rays += direct.shadow_rays;
+                    direct.unweighted()
+                } else {
+                    let (direct, direct_rays) = direct_with_bsdf_sample(
+                        world,
+                        &hit,
+                        material,
+                        &frame,
+                        wo_world,
+                        Rgb::WHITE,
+                        sampler,
+                    );
+                    rays += direct_rays;
+                    direct
+                };
                 let at = ShadingPoint::new(&hit, material, wo_world);
-                let direct = sample_direct(world, ctx.scene, &at, u_choice, u_light);
-                rays += direct.shadow_rays;
                 let caustic = estimate(&maps.caustic, 0, &mut scratch.caustic);
                 let indirect = if settings.final_gather_samples > 0 {
                     let (gathered, gather_rays) = final_gather(ctx, &at, gather, scratch);
@@ -142,7 +160,7 @@ pub fn radiance(
                 } else {
                     estimate(&maps.global, 0, &mut scratch.global)
                 };
-                direct.unweighted() + caustic + indirect
+                direct + caustic + indirect
             }
             Visualize::Caustic => estimate(&maps.caustic, 0, &mut scratch.caustic),
             Visualize::Global => estimate(&maps.global, FIRST_DIFFUSE, &mut scratch.global),

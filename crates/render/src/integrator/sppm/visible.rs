@@ -12,7 +12,9 @@ use glam::Vec3;
 
 use crate::context::RenderContext;
 use crate::integrator::direct::{ShadingPoint, sample_direct};
-use crate::integrator::specular::{ChainVertex, chain_bounce, glossy_direct};
+use crate::integrator::specular::{
+    ChainVertex, chain_bounce, direct_with_bsdf_sample, glossy_direct,
+};
 use crate::material::Material;
 use crate::world::World;
 use radiant_math::color::Rgb;
@@ -128,12 +130,26 @@ pub fn camera_sample(
             ray = hit.spawn_ray(wi);
             continue;
         }
-        let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
-        let u_light = sampler.get_2d();
-        let at = ShadingPoint::new(&hit, material, wo_world);
-        let direct = sample_direct(world, scene, &at, u_choice, u_light);
-        out.rays += direct.shadow_rays;
-        out.ld += beta * direct.unweighted();
+        if material.is_diffuse() {
+            let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
+            let u_light = sampler.get_2d();
+            let at = ShadingPoint::new(&hit, material, wo_world);
+            let direct = sample_direct(world, scene, &at, u_choice, u_light);
+            out.rays += direct.shadow_rays;
+            out.ld += beta * direct.unweighted();
+        } else {
+            let (direct, rays) = direct_with_bsdf_sample(
+                world,
+                &hit,
+                material,
+                &frame,
+                wo_world,
+                beta,
+                &mut sampler,
+            );
+            out.rays += rays;
+            out.ld += direct;
+        }
         out.vp = VisiblePoint {
             p: hit.p,
             n: if hit.ng.dot(wo_world) >= 0.0 {
