@@ -2,7 +2,7 @@
 //! projection maps, the furnace, the cornell-caustics reference, the spot-lit caustic
 //! the path tracer cannot render, visualisations, snapshots, cancellation,
 //! determinism and parameters; rough glass against the path tracer and the power
-//! its photons carry on.
+//! its photons carry on; glossy and polished surfaces against the path tracer.
 
 #[path = "../common/mod.rs"]
 mod common;

@@ -27,7 +27,7 @@ const TILE: usize = 8;
 const PASSES: u64 = 4;
 
 /// `desc` with its (smooth, η = 1.5) glass made rough.
-fn roughened(mut desc: SceneDesc) -> SceneDesc {
+pub fn roughened(mut desc: SceneDesc) -> SceneDesc {
     let alpha = 0.1f32.sqrt();
     let mut found = 0;
     for m in &mut desc.materials {

@@ -31,6 +31,10 @@ pub enum TransportMode {
     Importance,
 }
 
+/// Microfacet roughness below which a conductor's lobe is too narrow for a photon
+/// density estimate (see [`Material::passes_photon_paths`]).
+pub const NARROW_LOBE_ALPHA: f32 = 0.1;
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Material {
     /// Lambertian: f = albedo / pi.
@@ -226,12 +230,23 @@ impl Material {
 
     /// True where the photon integrators (photon map, SPPM) treat the surface like a
     /// specular one: camera paths continue through it by sampling its BSDF and photons
-    /// are not stored on it. That is every delta BSDF and the rough dielectric, whose
-    /// transmitted light a density estimate on the reflecting side could not gather;
-    /// rough conductors are glossy surfaces that keep photons and visible points, the
-    /// BSDF evaluated in the estimate (as in pbrt-v4's SPPM).
+    /// are not stored on it. That is every delta BSDF, the rough dielectric, whose
+    /// transmitted light a density estimate on the reflecting side could not gather,
+    /// and conductors too smooth for one ([`NARROW_LOBE_ALPHA`]): the estimate weighs
+    /// each photon by the BSDF, about 1 / (π α²) at the lobe's peak, so a few photons
+    /// near the mirror direction made fireflies (pbrt-v4's killeroo-gold, α = 0.045:
+    /// SPPM's relMSE ten times the path tracer's). Highly glossy reflection is left to
+    /// ray tracing, as Jensen does ("Realistic Image Synthesis Using Photon Mapping",
+    /// 2001, ch. 9). Broader conductors keep photons and visible points, the BSDF
+    /// evaluated in the estimate (as in pbrt-v4's SPPM).
     pub fn passes_photon_paths(&self) -> bool {
-        self.is_specular() || matches!(self, Material::RoughDielectric { .. })
+        match self {
+            Material::RoughDielectric { .. } => true,
+            Material::RoughConductor { distribution, .. } => {
+                distribution.alpha_x.max(distribution.alpha_y) < NARROW_LOBE_ALPHA
+            }
+            _ => self.is_specular(),
+        }
     }
 
     /// True where a non-delta BSDF transmits: density estimates there take photons
