@@ -235,6 +235,7 @@ impl HemiCube {
         buffers: &mut HemiCubeBuffers,
         out: &mut [f64],
     ) {
+        // A covered patch is separated from every patch, itself included.
         if vis.separated(from, from) {
             out.fill(0.0);
             return;
