@@ -159,42 +159,41 @@ pub fn glossy_direct(
     (l, ds.shadow_rays)
 }
 
-/// Direct light at the end of a camera chain (an SPPM visible point, the photon
-/// mapper's estimate point) whose BSDF is not Lambertian (glossy conductors, coated
-/// surfaces), times the path throughput `beta`: a light sample and a BSDF
-/// sample weighted by multiple importance sampling (Veach & Guibas 1995, the power
-/// heuristic), with the number of rays traced. A light sample alone finds a narrow
-/// lobe's reflection of a light (an environment in a varnish coat) only in rare, very
-/// bright samples, so the pixel mean converged slowly from below; the BSDF sample finds
-/// it every time. Photons still carry only indirect light.
-pub fn direct_with_bsdf_sample(
+/// Direct light where a camera chain ends (an SPPM visible point, the photon mapper's
+/// estimate point), with the number of rays traced. At a Lambertian point a light
+/// sample; where the BSDF is not Lambertian (glossy conductors, coated surfaces), a
+/// light sample and a BSDF sample weighted by multiple importance sampling (Veach &
+/// Guibas 1995, the power heuristic). A light sample alone finds a narrow lobe's
+/// reflection of a light (an environment in a varnish coat) only in rare, very bright
+/// samples, so the pixel mean converged slowly from below; the BSDF sample finds it
+/// every time. The photons carry only indirect light.
+pub fn chain_end_direct(
     world: &World,
+    scene: SceneSphere,
     hit: &SurfaceHit,
     material: Material,
     frame: &Frame,
     wo_world: Vec3,
-    beta: Rgb,
     sampler: &mut PixelSample,
 ) -> (Rgb, u32) {
-    let (light, mut rays) = glossy_direct(
-        world,
-        world.scene_sphere(),
-        hit,
-        material,
-        wo_world,
-        sampler,
-    );
-    let mut ld = beta * light;
-    let mut through = beta;
+    if material.is_diffuse() {
+        let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
+        let u_light = sampler.get_2d();
+        let at = ShadingPoint::new(hit, material, wo_world);
+        let direct = sample_direct(world, scene, &at, u_choice, u_light);
+        return (direct.unweighted(), direct.shadow_rays);
+    }
+    let (mut l, mut rays) = glossy_direct(world, scene, hit, material, wo_world, sampler);
+    let mut through = Rgb::WHITE;
     if let Some((wi, vertex)) = chain_bounce(hit, &material, frame, wo_world, sampler, &mut through)
     {
         rays += 1;
         let ray = hit.spawn_ray(wi);
-        ld += through
+        l += through
             * match world.intersect(&ray, f32::INFINITY) {
                 Some(next) => vertex.emission(world, &next, -ray.d.normalize()),
                 None => vertex.environment(world, ray.d),
             };
     }
-    (ld, rays)
+    (l, rays)
 }

@@ -12,7 +12,7 @@ use super::{PhotonMaps, facing};
 use crate::geometry::Ray;
 use crate::integrator::direct::{ShadingPoint, sample_direct, sides_agree};
 use crate::integrator::specular::{
-    ChainVertex, chain_bounce, direct_with_bsdf_sample, glossy_direct, specular_bounce,
+    ChainVertex, chain_bounce, chain_end_direct, glossy_direct, specular_bounce,
 };
 use crate::light::SceneSphere;
 use crate::material::{Material, TransportMode};
@@ -131,26 +131,9 @@ pub fn radiance(
         let reflected = match settings.visualize {
             Visualize::None => {
                 l += beta * emitted;
-                let direct = if material.is_diffuse() {
-                    let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
-                    let u_light = sampler.get_2d();
-                    let at = ShadingPoint::new(&hit, material, wo_world);
-                    let direct = sample_direct(world, ctx.scene, &at, u_choice, u_light);
-                    rays += direct.shadow_rays;
-                    direct.unweighted()
-                } else {
-                    let (direct, direct_rays) = direct_with_bsdf_sample(
-                        world,
-                        &hit,
-                        material,
-                        &frame,
-                        wo_world,
-                        Rgb::WHITE,
-                        sampler,
-                    );
-                    rays += direct_rays;
-                    direct
-                };
+                let (direct, direct_rays) =
+                    chain_end_direct(world, ctx.scene, &hit, material, &frame, wo_world, sampler);
+                rays += direct_rays;
                 let at = ShadingPoint::new(&hit, material, wo_world);
                 let caustic = estimate(&maps.caustic, 0, &mut scratch.caustic);
                 let indirect = if settings.final_gather_samples > 0 {

@@ -5,16 +5,14 @@
 //! to one point's radiance).
 //!
 //! Direct light is computed here, by next-event estimation at the visible point (as
-//! pbrt-v4 does), together with emission seen through the specular chain; photons then
-//! only carry indirect light (they are not deposited at their first hit).
+//! pbrt-v4 does; weighted against a BSDF sample where the point is glossy, see
+//! [`chain_end_direct`]), together with emission seen through the specular chain;
+//! photons then only carry indirect light (they are not deposited at their first hit).
 
 use glam::Vec3;
 
 use crate::context::RenderContext;
-use crate::integrator::direct::{ShadingPoint, sample_direct};
-use crate::integrator::specular::{
-    ChainVertex, chain_bounce, direct_with_bsdf_sample, glossy_direct,
-};
+use crate::integrator::specular::{ChainVertex, chain_bounce, chain_end_direct, glossy_direct};
 use crate::material::Material;
 use crate::world::World;
 use radiant_math::color::Rgb;
@@ -130,26 +128,10 @@ pub fn camera_sample(
             ray = hit.spawn_ray(wi);
             continue;
         }
-        if material.is_diffuse() {
-            let u_choice = sampler.get_1d_if(world.light_sampler.uses_choice_sample());
-            let u_light = sampler.get_2d();
-            let at = ShadingPoint::new(&hit, material, wo_world);
-            let direct = sample_direct(world, scene, &at, u_choice, u_light);
-            out.rays += direct.shadow_rays;
-            out.ld += beta * direct.unweighted();
-        } else {
-            let (direct, rays) = direct_with_bsdf_sample(
-                world,
-                &hit,
-                material,
-                &frame,
-                wo_world,
-                beta,
-                &mut sampler,
-            );
-            out.rays += rays;
-            out.ld += direct;
-        }
+        let (direct, rays) =
+            chain_end_direct(world, scene, &hit, material, &frame, wo_world, &mut sampler);
+        out.rays += rays;
+        out.ld += beta * direct;
         out.vp = VisiblePoint {
             p: hit.p,
             n: if hit.ng.dot(wo_world) >= 0.0 {
