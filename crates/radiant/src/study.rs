@@ -193,15 +193,8 @@ pub fn measure(
         *e = 0.0;
     }
     let whole = Crop::full(test.width, test.height);
-    let flip_mean = if unmeasured.contains(&true) {
-        flip.mean = measured_mean(&flip.errors, &unmeasured, flip.width, whole);
-        measured_mean(&flip.errors, &unmeasured, flip.width, crop.unwrap_or(whole))
-    } else {
-        match crop {
-            None => flip.mean,
-            Some(c) => crop_mean(&flip.errors, flip.width, c),
-        }
-    };
+    flip.mean = measured_mean(&flip.errors, &unmeasured, flip.width, whole);
+    let flip_mean = measured_mean(&flip.errors, &unmeasured, flip.width, crop.unwrap_or(whole));
     Ok(Measured {
         metrics,
         flip,
@@ -209,8 +202,8 @@ pub fn measure(
     })
 }
 
-/// Mean of a row-major map over `crop`, leaving out the pixels marked in `skip`; NaN
-/// where every pixel is left out.
+/// Mean of a row-major map over `crop`, summed in f64 in row order, leaving out the
+/// pixels marked in `skip`; NaN where every pixel is left out.
 fn measured_mean(values: &[f32], skip: &[bool], width: usize, crop: Crop) -> f64 {
     let (mut sum, mut n) = (0.0f64, 0usize);
     for y in crop.y0..crop.y1 {
@@ -225,17 +218,6 @@ fn measured_mean(values: &[f32], skip: &[bool], width: usize, crop: Crop) -> f64
         }
     }
     if n == 0 { f64::NAN } else { sum / n as f64 }
-}
-
-/// Mean of a row-major map over `crop`, summed in f64 in row order.
-pub fn crop_mean(values: &[f32], width: usize, crop: Crop) -> f64 {
-    let mut sum = 0.0f64;
-    for y in crop.y0..crop.y1 {
-        for &v in &values[y * width + crop.x0..y * width + crop.x1] {
-            sum += f64::from(v);
-        }
-    }
-    sum / (crop.width() * crop.height()) as f64
 }
 
 /// The error of one snapshot, with every figure (the report plots relMSE and ꟻLIP).
@@ -746,10 +728,8 @@ mod tests {
             compare(&test, &reference, Some(crop)).unwrap()
         );
         assert_eq!(whole.flip_mean, whole.flip.mean);
-        assert_eq!(
-            crop_mean(&whole.flip.errors, 24, Crop::full(24, 16)),
-            whole.flip.mean
-        );
+        let in_row_order: f64 = whole.flip.errors.iter().map(|&e| f64::from(e)).sum();
+        assert_eq!(in_row_order / (24 * 16) as f64, whole.flip.mean);
         // The map is the same; only the pixels averaged differ.
         assert_eq!(part.flip.errors, whole.flip.errors);
         let by_hand: f64 = (crop.y0..crop.y1)
@@ -790,12 +770,16 @@ mod tests {
         let m = measure(&test, &reference, None, DEFAULT_PIXELS_PER_DEGREE).unwrap();
         let a = measure(&test, &agreeing, None, DEFAULT_PIXELS_PER_DEGREE).unwrap();
         assert_eq!(m.flip.error_at(4, 5), 0.0);
-        let others: Vec<f64> = (0..10)
-            .flat_map(|y| (0..12).map(move |x| (x, y)))
-            .filter(|&p| p != (4, 5))
-            .map(|(x, y)| f64::from(a.flip.error_at(x, y)))
-            .collect();
-        let mean = others.iter().sum::<f64>() / others.len() as f64;
+        // The agreeing map's mean over a rectangle, the pixel (4, 5) left out.
+        let mean_without = |xs: std::ops::Range<usize>, ys: std::ops::Range<usize>| {
+            let others: Vec<f64> = ys
+                .flat_map(|y| xs.clone().map(move |x| (x, y)))
+                .filter(|&p| p != (4, 5))
+                .map(|(x, y)| f64::from(a.flip.error_at(x, y)))
+                .collect();
+            others.iter().sum::<f64>() / others.len() as f64
+        };
+        let mean = mean_without(0..12, 0..10);
         assert!(
             (m.flip_mean - mean).abs() < 1e-12,
             "{} vs {mean}",
@@ -819,13 +803,7 @@ mod tests {
             y1: 8,
         };
         let c = measure(&test, &reference, Some(crop), DEFAULT_PIXELS_PER_DEGREE).unwrap();
-        let in_crop: Vec<f64> = (3..8)
-            .flat_map(|y| (2..7).map(move |x| (x, y)))
-            .filter(|&p| p != (4, 5))
-            .map(|(x, y)| f64::from(a.flip.error_at(x, y)))
-            .collect();
-        let crop_mean = in_crop.iter().sum::<f64>() / in_crop.len() as f64;
-        assert!((c.flip_mean - crop_mean).abs() < 1e-12);
+        assert!((c.flip_mean - mean_without(2..7, 3..8)).abs() < 1e-12);
     }
 
     #[test]
