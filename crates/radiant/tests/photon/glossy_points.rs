@@ -15,7 +15,7 @@ use radiant::scene::params::{ParamSet, ParamValue};
 use radiant::scene::{MaterialDesc, SceneDesc};
 
 use crate::common;
-use crate::rough_glass::roughened;
+use crate::rough_glass::{photon_methods_match_the_path_tracer, roughened};
 use crate::scenes::with_integrator;
 
 const RES: u32 = 32;
@@ -89,15 +89,10 @@ fn glossy_visible_points_see_the_light_their_lobes_reflect() {
 /// metal is indirect light, which a photon estimate on the metal would weigh by a lobe
 /// peaking near 1 / (π α²) ≈ 350, a few photons making fireflies. The metal passes
 /// camera paths on instead, and SPPM and the photon mapper match the path tracer tile by
-/// tile, as in `rough_glass`, and SPPM's tiles are no noisier than the path tracer's.
+/// tile (`photon_methods_match_the_path_tracer`), and SPPM's tiles are no noisier than
+/// the path tracer's.
 #[test]
 fn polished_metal_passes_camera_paths_on() {
-    const RES: u32 = 64;
-    const CRITERION: TileCriterion = TileCriterion {
-        k: 4.0,
-        rel_floor: 0.01,
-        abs_floor: 0.0,
-    };
     let mut scene = roughened(cornell_caustics());
     let mut found = 0;
     for m in &mut scene.materials {
@@ -111,26 +106,7 @@ fn polished_metal_passes_camera_paths_on() {
         }
     }
     assert_eq!(found, 1, "one mirror expected");
-    let depth = ParamSet::new().with("maxdepth", ParamValue::Int(vec![100]));
-    let passes = |desc: &SceneDesc, spp| {
-        TileStats::from_passes(&common::render_passes(desc, spp, PASSES), 8).unwrap()
-    };
-    let path = with_integrator(scene.clone(), "path", depth.clone(), Some(RES));
-    let (reference, _) = passes(&path, 256);
-    let sppm = with_integrator(scene.clone(), "sppm", depth.clone(), Some(RES));
-    let (s, s_img) = passes(&sppm, 64);
-    let cmp = compare_tiles(&s, &reference, CRITERION, &|_, _| false).unwrap();
-    common::assert_tiles("polished-metal-sppm", &cmp, &s_img);
-    let params = depth
-        .with("photons", ParamValue::Int(vec![50_000]))
-        .with("causticphotons", ParamValue::Int(vec![100_000]))
-        .with("finalgathersamples", ParamValue::Int(vec![8]))
-        .with("lookup", ParamValue::Int(vec![50]))
-        .with("globallookup", ParamValue::Int(vec![100]));
-    let pm = with_integrator(scene, "photonmap", params, Some(RES));
-    let (p, p_img) = passes(&pm, 4);
-    let cmp = compare_tiles(&p, &reference, CRITERION, &|_, _| false).unwrap();
-    common::assert_tiles("polished-metal-photonmap", &cmp, &p_img);
+    let (reference, s) = photon_methods_match_the_path_tracer(scene, "polished-metal");
     // Without the pass-through the fireflies show as noise: SPPM's summed tile
     // variance was 18 times the path tracer's (2.9e-3 against 1.6e-4); with it, 0.6
     // times (9.8e-5).

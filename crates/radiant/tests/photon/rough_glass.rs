@@ -56,26 +56,23 @@ fn passes(desc: &SceneDesc, spp: u32) -> (TileStats, Image) {
 }
 
 /// Path tracer (4 × 256 spp), SPPM (4 × 64 iterations) and the photon mapper (4 × 4 spp
-/// of 8 gather rays), each as four independent passes whose spread gives every 8 × 8
-/// tile mean its standard error (`radiant::image::tiles`). A tile passes within 4
-/// standard errors of the two images plus 1 % of the path tracer's mean: the density
-/// estimates' kernel bias, which the final radii here (SPPM after 64 iterations, the
-/// photon mapper's 50-photon caustic lookups) keep below that on these smooth walls
-/// (measured: every tile outside the sphere within 4 SE with no floor at all).
-///
-/// Every tile counts, those that see the room through the rough sphere included:
-/// there the ceiling light seen in and through the glass is found by light samples at
-/// the glass's vertices (weighted by MIS against the sampled bounce). Treated as a
-/// specular surface, with the bounce alone, it arrives in rare, very bright samples,
-/// and at these sample counts the photon mapper's tiles behind the sphere fail.
-#[test]
-fn sppm_and_photon_map_match_the_path_tracer_through_rough_glass() {
+/// of 8 gather rays) on `scene` at 64 × 64, each as four independent passes whose
+/// spread gives every 8 × 8 tile mean its standard error (`radiant::image::tiles`). A
+/// tile passes within 4 standard errors of the two images plus 1 % of the path
+/// tracer's mean: the density estimates' kernel bias, which the final radii here (SPPM
+/// after 64 iterations, the photon mapper's 50-photon caustic lookups) keep below that
+/// on these smooth walls (measured on the rough-glass room: every tile outside the
+/// sphere within 4 SE with no floor at all). Failures are reported as `{name}-sppm` and
+/// `{name}-photonmap`. Returns the path tracer's and SPPM's tile statistics.
+pub fn photon_methods_match_the_path_tracer(
+    scene: SceneDesc,
+    name: &str,
+) -> (TileStats, TileStats) {
     const CRITERION: TileCriterion = TileCriterion {
         k: 4.0,
         rel_floor: 0.01,
         abs_floor: 0.0,
     };
-    let scene = roughened(cornell_caustics());
     let depth = ParamSet::new().with("maxdepth", ParamValue::Int(vec![100]));
     let path = with_integrator(scene.clone(), "path", depth.clone(), Some(RES));
     let (reference, _) = passes(&path, 256);
@@ -83,7 +80,7 @@ fn sppm_and_photon_map_match_the_path_tracer_through_rough_glass() {
     let sppm = with_integrator(scene.clone(), "sppm", depth.clone(), Some(RES));
     let (s, s_img) = passes(&sppm, 64);
     let cmp = compare_tiles(&s, &reference, CRITERION, &|_, _| false).unwrap();
-    common::assert_tiles("rough-glass-sppm", &cmp, &s_img);
+    common::assert_tiles(&format!("{name}-sppm"), &cmp, &s_img);
 
     let params = depth
         .with("photons", ParamValue::Int(vec![50_000]))
@@ -94,7 +91,19 @@ fn sppm_and_photon_map_match_the_path_tracer_through_rough_glass() {
     let pm = with_integrator(scene, "photonmap", params, Some(RES));
     let (p, p_img) = passes(&pm, 4);
     let cmp = compare_tiles(&p, &reference, CRITERION, &|_, _| false).unwrap();
-    common::assert_tiles("rough-glass-photonmap", &cmp, &p_img);
+    common::assert_tiles(&format!("{name}-photonmap"), &cmp, &p_img);
+    (reference, s)
+}
+
+/// [`photon_methods_match_the_path_tracer`] in cornell-caustics with its glass made
+/// rough. Every tile counts, those that see the room through the rough sphere included:
+/// there the ceiling light seen in and through the glass is found by light samples at
+/// the glass's vertices (weighted by MIS against the sampled bounce). Treated as a
+/// specular surface, with the bounce alone, it arrives in rare, very bright samples,
+/// and at these sample counts the photon mapper's tiles behind the sphere fail.
+#[test]
+fn sppm_and_photon_map_match_the_path_tracer_through_rough_glass() {
+    photon_methods_match_the_path_tracer(roughened(cornell_caustics()), "rough-glass");
 }
 
 /// In the closed room (front wall added, mirror of reflectance 1) every photon
