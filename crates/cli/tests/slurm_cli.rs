@@ -157,8 +157,8 @@ fn values_cannot_add_lines_or_words_to_the_scripts() {
     std::fs::remove_dir_all(&d).ok();
 }
 
-/// A small job whose scripts go to the folder `job`.
-const CLEANUP_JOB: [&str; 9] = [
+/// A small job, to which the test adds where its scripts go.
+const CLEANUP_JOB: [&str; 7] = [
     "slurm",
     "--parts",
     "2",
@@ -166,8 +166,6 @@ const CLEANUP_JOB: [&str; 9] = [
     "8x6",
     "-o",
     "out.exr",
-    "--dir",
-    "job",
 ];
 
 #[test]
@@ -176,7 +174,7 @@ fn a_failed_run_removes_the_folders_it_made() {
     // The job script cannot be written (a folder holds its name), as on a full disk.
     let job = d.join("job");
     std::fs::create_dir_all(job.join("render.sbatch")).unwrap();
-    let e = failure(&d, &CLEANUP_JOB);
+    let e = failure(&d, &[&CLEANUP_JOB[..], &["--dir", "job"]].concat());
     assert!(e.contains("render.sbatch"), "{e}");
     assert_eq!(
         entries(&job),
@@ -186,25 +184,15 @@ fn a_failed_run_removes_the_folders_it_made() {
     // A script written before the failure goes too.
     std::fs::remove_dir(job.join("render.sbatch")).unwrap();
     std::fs::create_dir(job.join("merge.sbatch")).unwrap();
-    let e = failure(&d, &CLEANUP_JOB);
+    let e = failure(&d, &[&CLEANUP_JOB[..], &["--dir", "job"]].concat());
     assert!(e.contains("merge.sbatch"), "{e}");
     assert_eq!(entries(&job), ["merge.sbatch"]);
     // With no sbatch to submit them, the folders the run made, to the top, are removed.
-    let out = Command::new(BIN)
+    let out = radiant()
         .current_dir(&d)
         .env("PATH", &job)
-        .args([
-            "slurm",
-            "--parts",
-            "2",
-            "--resolution",
-            "8x6",
-            "-o",
-            "out.exr",
-            "--dir",
-            "new/deeper",
-            "--submit",
-        ])
+        .args(CLEANUP_JOB)
+        .args(["--dir", "new/deeper", "--submit"])
         .output()
         .expect("runs");
     let stderr = String::from_utf8_lossy(&out.stderr);
