@@ -6,12 +6,13 @@
 //! coat, the single-scattering loss of its microfacets, both predicted in closed
 //! form from the coat alone; every albedo at most 1; reciprocity of the expected BSDF;
 //! the mean sample weight equals the quadrature of eval · cos; the diffuse albedo
-//! approximation against the walk at normal incidence.
+//! approximation against the walk at normal incidence; a narrow coat's reflection and
+//! the light under it, as the photon integrators take them apart, add up to the whole.
 
 use glam::{Vec2, Vec3};
 use radiant_math::color::Rgb;
 use radiant_math::hash::Pcg32;
-use radiant_render::material::{Material, TransportMode, fresnel};
+use radiant_render::material::{CoatPart, Material, TransportMode, fresnel};
 use radiant_scene::{CoatDesc, ConductorDesc, MaterialDesc};
 use radiant_testkit::chi2::{ChiSquareTest, Domain};
 use std::f64::consts::{FRAC_PI_2, TAU};
@@ -110,6 +111,11 @@ fn jitter(w: Vec3, k: u32) -> Vec3 {
 /// (θ, φ), with its standard error: every node takes two independent estimates,
 /// whose difference measures that node's variance.
 fn eval_integral(m: &Material, wo: Vec3, mode: TransportMode, n: usize) -> (f64, f64) {
+    integral_of(|wo, wi| m.eval_mode(wo, wi, mode).g as f64, wo, n)
+}
+
+/// [`eval_integral`] of any BSDF-like `f(wo, wi)`.
+fn integral_of(f: impl Fn(Vec3, Vec3) -> f64, wo: Vec3, n: usize) -> (f64, f64) {
     let (nt, np) = (n, 2 * n);
     let (dt, dp) = (FRAC_PI_2 / nt as f64, TAU / np as f64);
     let (mut sum, mut var) = (0.0, 0.0);
@@ -119,7 +125,7 @@ fn eval_integral(m: &Material, wo: Vec3, mode: TransportMode, n: usize) -> (f64,
         for j in 0..np {
             let (sp, cp) = ((j as f64 + 0.5) * dp).sin_cos();
             let wi = Vec3::new((st * cp) as f32, (st * sp) as f32, ct as f32);
-            let [a, b] = [0, 1].map(|k| m.eval_mode(jitter(wo, k), wi, mode).g as f64);
+            let [a, b] = [0, 1].map(|k| f(jitter(wo, k), wi));
             let w = ct * st * dt * dp;
             sum += w * 0.5 * (a + b);
             // Var of the mean of two: (a - b)² / 4 estimates it without bias.
@@ -528,4 +534,85 @@ fn coated_diffuse_bases_match_spectral_interreflection() {
     let m = Material::from_desc(&radiant_render::material::spectrally_matched(&desc));
     let plain = Material::from_desc(&desc);
     assert!(m.diffuse_albedo().r < 0.85 * plain.diffuse_albedo().r);
+}
+
+/// The photon integrators take a surface under a narrow coat apart
+/// (`Material::narrow_coat`): a camera path follows the coat's reflection with
+/// probability F(θo) and gathers the light under the coat otherwise. The two parts'
+/// weights must add up to the whole BSDF's: the mean of the chosen part's weight (the
+/// reflection's, or the choice's times a sample of the light under the coat) equals
+/// the whole sampler's albedo, and the samples without the coat's reflection integrate
+/// `eval_under_coat` (quadrature). A mistaken choice probability or a weight left
+/// undivided by it breaks the first; a coat reflection left in either part breaks both.
+#[test]
+fn a_narrow_coat_and_the_light_under_it_add_up_to_the_whole() {
+    const N: u32 = 200_000;
+    let mean_se = |s: f64, s2: f64| {
+        let mean = s / N as f64;
+        (
+            mean,
+            ((s2 / N as f64 - mean * mean).max(0.0) / N as f64).sqrt(),
+        )
+    };
+    for (name, m) in [
+        ("smooth coat", coated_diffuse(0.7, coat(0.0))),
+        ("coat alpha 0.001", coated_diffuse(0.7, coat(0.001))),
+        (
+            "coat alpha 0.05 over rough gold",
+            coated_gold(0.3, coat(0.05)),
+        ),
+    ] {
+        let layers = *m.narrow_coat().expect("a narrow coat over a broad base");
+        for cos_o in [0.9f32, 0.4, 0.08] {
+            let wo = direction(cos_o, 1.3);
+            let mode = TransportMode::Radiance;
+            let (whole, whole_se, _) = sampled_albedo(&m, wo, mode, N);
+            let mut rng = Pcg32::new(11, 5);
+            let (mut split, mut split2, mut under, mut under2) = (0.0, 0.0, 0.0, 0.0);
+            for _ in 0..N {
+                let u = |rng: &mut Pcg32| Vec2::new(rng.uniform(), rng.uniform());
+                let under_weight = |rng: &mut Pcg32| {
+                    let (u1, u2) = (rng.uniform(), u(rng));
+                    m.sample_under_coat(wo, u1, u2, mode)
+                        .map_or(0.0, |bs| (bs.f.g * bs.wi.z.abs() / bs.pdf) as f64)
+                };
+                let w = under_weight(&mut rng);
+                under += w;
+                under2 += w * w;
+                let (u1, u2) = (rng.uniform(), u(&mut rng));
+                let w = match layers.choose_coat_part(wo, u1, u2) {
+                    Some(CoatPart::Reflection { wi, weight }) => {
+                        assert!(wi.z > 0.0, "{name}: reflection below the surface");
+                        weight as f64
+                    }
+                    Some(CoatPart::Under { weight }) => weight as f64 * under_weight(&mut rng),
+                    None => 0.0,
+                };
+                split += w;
+                split2 += w * w;
+            }
+            let (split, split_se) = mean_se(split, split2);
+            let (under, under_se) = mean_se(under, under2);
+            let (q, q_noise) =
+                integral_of(|wo, wi| m.eval_under_coat(wo, wi, mode).g as f64, wo, 100);
+            println!(
+                "{name}, cos {cos_o}: whole {whole:.5} ± {whole_se:.5}, split {split:.5} ± \
+                 {split_se:.5}; under the coat sampled {under:.5} ± {under_se:.5}, \
+                 quadrature {q:.5} ± {q_noise:.5}"
+            );
+            assert!(
+                (split - whole).abs() < 4.0 * whole_se.hypot(split_se) + 1e-3,
+                "{name}, cos {cos_o}: split {split} against the whole {whole}"
+            );
+            assert!(
+                (under - q).abs() < 4.0 * under_se.hypot(q_noise) + 2e-3,
+                "{name}, cos {cos_o}: sampled under the coat {under} against quadrature {q}"
+            );
+        }
+    }
+    // Broad coats keep the whole BSDF; narrow lobes over narrow bases pass photon
+    // paths on whole.
+    assert!(coated_diffuse(0.7, coat(0.3)).narrow_coat().is_none());
+    let polished = coated_gold(0.01, coat(0.001));
+    assert!(polished.passes_photon_paths() && polished.narrow_coat().is_none());
 }

@@ -14,7 +14,7 @@ use glam::Vec3;
 
 use crate::integrator::direct::{ShadingPoint, sample_direct, sides_agree, surface_emission};
 use crate::light::{Light, LightSampleContext, SceneSphere};
-use crate::material::{Material, TransportMode};
+use crate::material::{CoatPart, Layered, Material, TransportMode};
 use crate::sampler::PixelSample;
 use crate::world::{NO_LIGHT, SurfaceHit, World};
 use radiant_math::Frame;
@@ -52,6 +52,9 @@ pub struct ChainVertex {
     specular: bool,
     /// The vertex as a receiver, as its light sample saw it.
     receiver: LightSampleContext,
+    /// The vertex's direct light was taken in full before this direction was chosen
+    /// ([`coat_step`]): the ray counts no emission, only what lies beyond.
+    indirect_only: bool,
 }
 
 impl ChainVertex {
@@ -61,12 +64,25 @@ impl ChainVertex {
             pdf: 0.0,
             specular: true,
             receiver: LightSampleContext::at_point(origin),
+            indirect_only: false,
+        }
+    }
+
+    /// A vertex whose direct light has been counted: the ray it spawns finds no
+    /// emission, lit surfaces only.
+    fn indirect_only(origin: Vec3) -> ChainVertex {
+        ChainVertex {
+            indirect_only: true,
+            ..ChainVertex::camera(origin)
         }
     }
 
     /// Emitted radiance at `hit` towards `wo_world`, weighted against the light sample
     /// the previous vertex took, when it took one.
     pub fn emission(&self, world: &World, hit: &SurfaceHit, wo_world: Vec3) -> Rgb {
+        if self.indirect_only {
+            return Rgb::BLACK;
+        }
         let le = surface_emission(world, hit, wo_world);
         if self.specular || le.is_black() || hit.light == NO_LIGHT {
             return le;
@@ -83,6 +99,9 @@ impl ChainVertex {
     /// against the previous vertex's light sample.
     pub fn environment(&self, world: &World, d: Vec3) -> Rgb {
         let mut sum = Rgb::BLACK;
+        if self.indirect_only {
+            return sum;
+        }
         for (i, light) in world.lights.iter().enumerate() {
             let le = light.environment(d);
             if le.is_black() {
@@ -128,6 +147,7 @@ pub fn chain_bounce(
         pdf: bs.pdf,
         specular: bs.specular,
         receiver: hit.light_sample_context().with_mis(),
+        indirect_only: false,
     };
     Some((wi, vertex))
 }
@@ -196,4 +216,55 @@ pub fn chain_end_direct(
             };
     }
     (l, rays)
+}
+
+/// Where a camera chain goes on at a surface under a narrow coat
+/// ([`Material::narrow_coat`]).
+#[derive(Clone, Copy, Debug)]
+pub enum CoatStep {
+    /// Along the coat's reflection: the ray to trace and how it was chosen.
+    Reflect(Vec3, ChainVertex),
+    /// The chain ends here and the light under the coat is gathered
+    /// ([`Material::eval_under_coat`]).
+    Under,
+}
+
+/// The choice between a narrow coat's reflection and the light under it
+/// ([`Layered::choose_coat_part`]), made after the vertex's direct light has been
+/// taken with the whole BSDF ([`chain_end_direct`]): the reflected ray therefore
+/// counts no emission, and its chain gathers what the coat reflects of lit surfaces
+/// (indirect light and caustics, which the photons under the coat no longer carry).
+/// Scales `beta` by the chosen part's weight; `None` ends the path. Draws three
+/// dimensions of `sampler` either way.
+pub fn coat_step(
+    hit: &SurfaceHit,
+    layers: &Layered,
+    frame: &Frame,
+    wo_world: Vec3,
+    sampler: &mut PixelSample,
+    beta: &mut Rgb,
+) -> Option<CoatStep> {
+    let u_part = sampler.get_1d();
+    let u_dir = sampler.get_2d();
+    let wo = frame.to_local(wo_world);
+    match layers.choose_coat_part(wo, u_part, u_dir)? {
+        CoatPart::Under { weight } => {
+            *beta *= weight;
+            Some(CoatStep::Under)
+        }
+        CoatPart::Reflection { wi, weight } => {
+            let wi_world = frame.to_world(wi);
+            if !sides_agree(hit, wo_world, wi_world, wo, wi) {
+                return None;
+            }
+            *beta *= weight;
+            if beta.is_black() {
+                return None;
+            }
+            Some(CoatStep::Reflect(
+                wi_world,
+                ChainVertex::indirect_only(hit.p),
+            ))
+        }
+    }
 }

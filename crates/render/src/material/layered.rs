@@ -41,7 +41,7 @@ use glam::{Vec2, Vec3};
 use super::fresnel;
 use super::microfacet::{TrowbridgeReitz, reflect};
 use super::rough::{self, ConductorFresnel};
-use super::{BsdfSample, TransportMode};
+use super::{BsdfSample, NARROW_LOBE_ALPHA, TransportMode};
 use radiant_math::color::Rgb;
 use radiant_math::hash::{Pcg32, hash_u64s};
 use radiant_math::sampling::{self, power_heuristic};
@@ -85,6 +85,18 @@ pub struct Layered {
     pub max_depth: u16,
     /// Walks averaged per `eval` and `pdf`.
     pub samples: u16,
+}
+
+/// The part of a coated surface a camera path goes on with
+/// ([`Layered::choose_coat_part`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CoatPart {
+    /// The coat's own reflection into `wi` (local frame); `weight` is f |cos| / pdf
+    /// over the choice's probability.
+    Reflection { wi: Vec3, weight: f32 },
+    /// The light under the coat ([`Layered::eval_under_coat`]), weighted by one over
+    /// the choice's probability.
+    Under { weight: f32 },
 }
 
 /// What a walk estimates: the BSDF value for a transport mode, or the density of
@@ -409,22 +421,79 @@ impl Layered {
         self.coat.distribution.is_none() && self.base.is_delta()
     }
 
+    /// True when the coat's lobe is too narrow for a photon density estimate: smooth,
+    /// or rough below [`NARROW_LOBE_ALPHA`].
+    pub fn coat_is_narrow(&self) -> bool {
+        self.coat
+            .distribution
+            .is_none_or(|d| d.alpha_x.max(d.alpha_y) < NARROW_LOBE_ALPHA)
+    }
+
+    /// True when the base's lobe is a delta or too narrow for a density estimate.
+    pub fn base_is_narrow(&self) -> bool {
+        match &self.base {
+            Base::Diffuse { .. } => false,
+            Base::Conductor { distribution, .. } => {
+                distribution.is_none_or(|d| d.alpha_x.max(d.alpha_y) < NARROW_LOBE_ALPHA)
+            }
+        }
+    }
+
     /// BSDF value, estimated by `samples` walks (see the module notes).
     pub fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
         let (wo, wi) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::BLACK;
         }
-        let mut f = Rgb::splat(self.coat.f(wo, wi, mode));
-        if !self.is_delta() && self.samples > 0 {
-            let mut rng = generator(wo, wi, EVAL_STREAM);
-            let mut sum = Rgb::BLACK;
-            for _ in 0..self.samples {
-                sum += self.walk(wo, wi, Quantity::Value(mode), &mut rng);
-            }
-            f += sum / self.samples as f32;
+        Rgb::splat(self.coat.f(wo, wi, mode)) + self.eval_walks(wo, wi, mode)
+    }
+
+    /// The BSDF without the coat's direct reflection: the light that enters the
+    /// layers and leaves them again.
+    pub fn eval_under_coat(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
+        let (wo, wi) = if wo.z < 0.0 { (-wo, -wi) } else { (wo, wi) };
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Rgb::BLACK;
         }
-        f
+        self.eval_walks(wo, wi, mode)
+    }
+
+    /// The walks' part of [`eval`](Self::eval), both directions above.
+    fn eval_walks(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
+        if self.is_delta() || self.samples == 0 {
+            return Rgb::BLACK;
+        }
+        let mut rng = generator(wo, wi, EVAL_STREAM);
+        let mut sum = Rgb::BLACK;
+        for _ in 0..self.samples {
+            sum += self.walk(wo, wi, Quantity::Value(mode), &mut rng);
+        }
+        sum / self.samples as f32
+    }
+
+    /// Chooses between the coat's direct reflection and the light under it for a
+    /// camera path arriving from `wo`: the reflection with probability F(cos θo), the
+    /// smooth coat's Fresnel reflectance (the share of the light the coat reflects),
+    /// its direction sampled from the coat alone with `u`. The weights are divided by
+    /// the choice's probability, so that either part's estimate stays unbiased.
+    pub fn choose_coat_part(&self, wo: Vec3, u1: f32, u: Vec2) -> Option<CoatPart> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let flip = wo.z < 0.0;
+        let wo = if flip { -wo } else { wo };
+        let p = fresnel::dielectric(wo.z, self.coat.eta).clamp(0.0, 1.0);
+        if u1 >= p {
+            return (p < 1.0).then(|| CoatPart::Under {
+                weight: 1.0 / (1.0 - p),
+            });
+        }
+        let r = self.coat.reflect(wo, u)?;
+        let weight = r.weight / p;
+        weight.is_finite().then(|| CoatPart::Reflection {
+            wi: if flip { -r.w } else { r.w },
+            weight,
+        })
     }
 
     /// Density of [`sample`](Self::sample)'s non-delta directions, estimated by
@@ -601,12 +670,39 @@ impl Layered {
 
     /// Samples `wi` by a random walk through the layers (see the module notes).
     pub fn sample(&self, wo: Vec3, u1: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
+        self.sample_walk(wo, u1, u, mode, true)
+    }
+
+    /// [`sample`](Self::sample) with the coat's direct reflection left out: `None`
+    /// where the coat reflects, so that the weights of the other samples estimate the
+    /// part of the light under the coat ([`eval_under_coat`](Self::eval_under_coat)).
+    pub fn sample_under_coat(
+        &self,
+        wo: Vec3,
+        u1: f32,
+        u: Vec2,
+        mode: TransportMode,
+    ) -> Option<BsdfSample> {
+        self.sample_walk(wo, u1, u, mode, false)
+    }
+
+    fn sample_walk(
+        &self,
+        wo: Vec3,
+        u1: f32,
+        u: Vec2,
+        mode: TransportMode,
+        with_coat_reflection: bool,
+    ) -> Option<BsdfSample> {
         if wo.z == 0.0 {
             return None;
         }
         let flip = wo.z < 0.0;
         let wo = if flip { -wo } else { wo };
         let (mut w, weight, _, mut all_delta) = self.coat.sample(wo, u1, u, mode)?;
+        if w.z > 0.0 && !with_coat_reflection {
+            return None;
+        }
         let mut beta = Rgb::splat(weight);
         let finish = |wi: Vec3, beta: Rgb, all_delta: bool| -> Option<BsdfSample> {
             let cos = wi.z.abs();

@@ -10,9 +10,10 @@ use super::record::FIRST_DIFFUSE;
 use super::settings::Visualize;
 use super::{PhotonMaps, facing};
 use crate::geometry::Ray;
-use crate::integrator::direct::{ShadingPoint, sample_direct, sides_agree};
+use crate::integrator::direct::{ShadingPoint, sides_agree};
 use crate::integrator::specular::{
-    ChainVertex, chain_bounce, chain_end_direct, glossy_direct, specular_bounce,
+    ChainVertex, CoatStep, chain_bounce, chain_end_direct, coat_step, glossy_direct,
+    specular_bounce,
 };
 use crate::light::SceneSphere;
 use crate::material::{Material, TransportMode};
@@ -108,13 +109,42 @@ pub fn radiance(
             ray = hit.spawn_ray(wi);
             continue;
         }
+        let mut under_coat = false;
+        if settings.visualize == Visualize::None {
+            l += beta * emitted;
+            let (direct, direct_rays) =
+                chain_end_direct(world, ctx.scene, &hit, material, &frame, wo_world, sampler);
+            rays += direct_rays;
+            l += beta * direct;
+            if let Some(layers) = material.narrow_coat() {
+                match coat_step(&hit, layers, &frame, wo_world, sampler, &mut beta) {
+                    None => break,
+                    Some(CoatStep::Reflect(wi, vertex)) => {
+                        if depth == settings.max_depth {
+                            break;
+                        }
+                        prev = vertex;
+                        ray = hit.spawn_ray(wi);
+                        continue;
+                    }
+                    Some(CoatStep::Under) => under_coat = true,
+                }
+            }
+        }
         let at = EstimatePoint {
             p: hit.p,
             n: facing(hit.ng, wo_world),
             two_sided: material.transmits_diffusely(),
         };
         let wo = frame.to_local(wo_world);
-        let bsdf = |wi: Vec3| material.eval(wo, frame.to_local(wi));
+        let bsdf = |wi: Vec3| {
+            let wi = frame.to_local(wi);
+            if under_coat {
+                material.eval_under_coat(wo, wi, TransportMode::Radiance)
+            } else {
+                material.eval(wo, wi)
+            }
+        };
         let maps = ctx.maps;
         // Radiance reflected towards the viewer by the photons of one map near the point.
         let estimate = |map, skip_flags, neighbours: &mut _| {
@@ -130,20 +160,17 @@ pub fn radiance(
         };
         let reflected = match settings.visualize {
             Visualize::None => {
-                l += beta * emitted;
-                let (direct, direct_rays) =
-                    chain_end_direct(world, ctx.scene, &hit, material, &frame, wo_world, sampler);
-                rays += direct_rays;
                 let at = ShadingPoint::new(&hit, material, wo_world);
                 let caustic = estimate(&maps.caustic, 0, &mut scratch.caustic);
                 let indirect = if settings.final_gather_samples > 0 {
-                    let (gathered, gather_rays) = final_gather(ctx, &at, gather, scratch);
+                    let (gathered, gather_rays) =
+                        final_gather(ctx, &at, under_coat, gather, scratch);
                     rays += gather_rays;
                     gathered
                 } else {
                     estimate(&maps.global, 0, &mut scratch.global)
                 };
-                direct + caustic + indirect
+                caustic + indirect
             }
             Visualize::Caustic => estimate(&maps.caustic, 0, &mut scratch.caustic),
             Visualize::Global => estimate(&maps.global, FIRST_DIFFUSE, &mut scratch.global),
@@ -175,14 +202,16 @@ fn photon_dots(maps: &PhotonMaps, at: &EstimatePoint, radius: f32) -> Rgb {
 }
 
 /// Indirect diffuse light at a camera path's diffuse point by final gathering: rays
-/// sampled from the BSDF follow specular chains to a diffuse point y, where the light
-/// leaving y is next-event estimation plus the precomputed irradiance (global and
-/// caustic maps) times the diffuse reflectance. Emission reached by gather rays is not
-/// counted (next-event estimation and the caustic map at the camera path's point hold
-/// those paths). Returns the radiance and the number of rays traced.
+/// sampled from the BSDF (without a narrow coat's reflection where `under_coat`) follow
+/// specular chains to a diffuse point y, where the light leaving y is next-event
+/// estimation plus the precomputed irradiance (global and caustic maps) times the
+/// diffuse reflectance. Emission reached by gather rays is not counted (next-event
+/// estimation and the caustic map at the camera path's point hold those paths).
+/// Returns the radiance and the number of rays traced.
 fn final_gather(
     ctx: &EyeContext,
     at: &ShadingPoint,
+    under_coat: bool,
     gather: GatherStream,
     scratch: &mut EyeScratch,
 ) -> (Rgb, u32) {
@@ -197,7 +226,12 @@ fn final_gather(
         let mut s = PixelSample::for_stream(gather.kind, gather.seed, gather.key, j);
         let u_lobe = s.get_1d_if(material.uses_lobe_sample());
         let u_dir = s.get_2d();
-        let Some(bs) = material.sample(wo, u_lobe, u_dir, TransportMode::Radiance) else {
+        let bs = if under_coat {
+            material.sample_under_coat(wo, u_lobe, u_dir, TransportMode::Radiance)
+        } else {
+            material.sample(wo, u_lobe, u_dir, TransportMode::Radiance)
+        };
+        let Some(bs) = bs else {
             continue;
         };
         let wi = frame.to_world(bs.wi);
@@ -222,11 +256,26 @@ fn final_gather(
                 ray = y.spawn_ray(wi);
                 continue;
             }
-            let u_choice = s.get_1d_if(world.light_sampler.uses_choice_sample());
-            let u_light = s.get_2d();
-            let at_y = ShadingPoint::new(&y, mat_y, wo_y_world);
-            let direct = sample_direct(world, ctx.scene, &at_y, u_choice, u_light);
-            rays += direct.shadow_rays;
+            // A light sample alone at a glossy y would weigh it by the lobe's peak
+            // where the light falls in it: the same MIS as at the camera path's end.
+            let (direct, direct_rays) =
+                chain_end_direct(world, ctx.scene, &y, mat_y, &frame_y, wo_y_world, &mut s);
+            rays += direct_rays;
+            sum += beta * direct;
+            // Under a narrow coat the photons are weighed without the coat's reflection,
+            // which the gather ray follows instead (the direct light above took the
+            // whole BSDF).
+            let mut under_coat_y = false;
+            if let Some(layers) = mat_y.narrow_coat() {
+                match coat_step(&y, layers, &frame_y, wo_y_world, &mut s, &mut beta) {
+                    None => break,
+                    Some(CoatStep::Reflect(wi, _)) => {
+                        ray = y.spawn_ray(wi);
+                        continue;
+                    }
+                    Some(CoatStep::Under) => under_coat_y = true,
+                }
+            }
             let at = EstimatePoint {
                 p: y.p,
                 n: facing(y.ng, wo_y_world),
@@ -239,14 +288,21 @@ fn final_gather(
                 // BSDF, not by an albedo: the two maps' radiance estimates with the BSDF
                 // evaluated per photon (Jensen 2001, §7.5). An irradiance times the
                 // diffuse albedo, zero for a rough metal, would drop all of it.
-                let bsdf = |wi: Vec3| mat_y.eval(wo_y, frame_y.to_local(wi));
+                let bsdf = |wi: Vec3| {
+                    let wi = frame_y.to_local(wi);
+                    if under_coat_y {
+                        mat_y.eval_under_coat(wo_y, wi, TransportMode::Radiance)
+                    } else {
+                        mat_y.eval(wo_y, wi)
+                    }
+                };
                 let estimate = |map, neighbours: &mut _| {
                     radiance_estimate(map, &at, maps.max_r2, settings.kernel, 0, neighbours, bsdf)
                 };
                 estimate(&maps.global, &mut scratch.global)
                     + estimate(&maps.caustic, &mut scratch.caustic)
             };
-            sum += beta * (direct.unweighted() + indirect);
+            sum += beta * indirect;
             break;
         }
     }

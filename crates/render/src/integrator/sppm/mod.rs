@@ -465,7 +465,7 @@ fn progress_estimate(est: &mut PhotonEstimate, grid: &PhotonGrid, vp: &VisiblePo
         if !front && !vp.material.transmits_diffusely() {
             return;
         }
-        let f = vp.material.eval(vp.wo, vp.frame.to_local(wi));
+        let f = vp.bsdf(wi);
         if !f.is_black() {
             sum += d.power * f;
             m += 1;

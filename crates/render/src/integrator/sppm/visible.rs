@@ -2,7 +2,8 @@
 //! specular chains to the first diffuse point, where a visible point is left for the
 //! photons (Hachisuka & Jensen 2009: a new random visible point per iteration makes
 //! the method stochastic and the pixel estimate converge to the pixel's integral, not
-//! to one point's radiance).
+//! to one point's radiance). Under a narrow coat the path either follows the coat's
+//! reflection or leaves the point for the light under the coat ([`coat_step`]).
 //!
 //! Direct light is computed here, by next-event estimation at the visible point (as
 //! pbrt-v4 does; weighted against a BSDF sample where the point is glossy, see
@@ -12,8 +13,10 @@
 use glam::Vec3;
 
 use crate::context::RenderContext;
-use crate::integrator::specular::{ChainVertex, chain_bounce, chain_end_direct, glossy_direct};
-use crate::material::Material;
+use crate::integrator::specular::{
+    ChainVertex, CoatStep, chain_bounce, chain_end_direct, coat_step, glossy_direct,
+};
+use crate::material::{Material, TransportMode};
 use crate::world::World;
 use radiant_math::color::Rgb;
 use radiant_math::{Frame, INV_PI};
@@ -36,6 +39,9 @@ pub struct VisiblePoint {
     /// then albedo/π exactly where a photon arrives on the side of `n`, and zero
     /// elsewhere, so photons are summed first and weighted once (`weigh`).
     pub lambertian: bool,
+    /// The point gathers only the light under a narrow coat, whose own reflection
+    /// the camera path follows instead ([`coat_step`]).
+    pub under_coat: bool,
     pub valid: bool,
 }
 
@@ -46,6 +52,17 @@ impl VisiblePoint {
         match self.material {
             Material::Diffuse { albedo } if self.lambertian => sum * albedo * INV_PI,
             _ => sum,
+        }
+    }
+
+    /// The BSDF that weighs a photon arriving from `wi` (world direction).
+    pub fn bsdf(&self, wi: Vec3) -> Rgb {
+        let wi = self.frame.to_local(wi);
+        if self.under_coat {
+            self.material
+                .eval_under_coat(self.wo, wi, TransportMode::Radiance)
+        } else {
+            self.material.eval(self.wo, wi)
         }
     }
 }
@@ -60,6 +77,7 @@ impl Default for VisiblePoint {
             beta: Rgb::BLACK,
             material: Material::Interface,
             lambertian: false,
+            under_coat: false,
             valid: false,
         }
     }
@@ -132,6 +150,21 @@ pub fn camera_sample(
             chain_end_direct(world, scene, &hit, material, &frame, wo_world, &mut sampler);
         out.rays += rays;
         out.ld += beta * direct;
+        let mut under_coat = false;
+        if let Some(layers) = material.narrow_coat() {
+            match coat_step(&hit, layers, &frame, wo_world, &mut sampler, &mut beta) {
+                None => break,
+                Some(CoatStep::Reflect(wi, vertex)) => {
+                    if depth == max_depth {
+                        break;
+                    }
+                    prev = vertex;
+                    ray = hit.spawn_ray(wi);
+                    continue;
+                }
+                Some(CoatStep::Under) => under_coat = true,
+            }
+        }
         out.vp = VisiblePoint {
             p: hit.p,
             n: if hit.ng.dot(wo_world) >= 0.0 {
@@ -146,6 +179,7 @@ pub fn camera_sample(
             lambertian: material.is_diffuse()
                 && (hit.ns == hit.ng || hit.ns == -hit.ng)
                 && wo.z != 0.0,
+            under_coat,
             valid: true,
         };
         break;
