@@ -12,7 +12,7 @@
 use glam::{Vec2, Vec3};
 use radiant_math::color::Rgb;
 use radiant_math::hash::Pcg32;
-use radiant_render::material::{CoatPart, Material, TransportMode, fresnel};
+use radiant_render::material::{BsdfPart, CoatPart, Material, TransportMode, fresnel};
 use radiant_scene::{CoatDesc, ConductorDesc, MaterialDesc};
 use radiant_testkit::chi2::{ChiSquareTest, Domain};
 use std::f64::consts::{FRAC_PI_2, TAU};
@@ -542,7 +542,7 @@ fn coated_diffuse_bases_match_spectral_interreflection() {
 /// weights must add up to the whole BSDF's: the mean of the chosen part's weight (the
 /// reflection's, or the choice's times a sample of the light under the coat) equals
 /// the whole sampler's albedo, and the samples without the coat's reflection integrate
-/// `eval_under_coat` (quadrature). A mistaken choice probability or a weight left
+/// the BSDF under the coat (quadrature). A mistaken choice probability or a weight left
 /// undivided by it breaks the first; a coat reflection left in either part breaks both.
 #[test]
 fn a_narrow_coat_and_the_light_under_it_add_up_to_the_whole() {
@@ -573,7 +573,7 @@ fn a_narrow_coat_and_the_light_under_it_add_up_to_the_whole() {
                 let u = |rng: &mut Pcg32| Vec2::new(rng.uniform(), rng.uniform());
                 let under_weight = |rng: &mut Pcg32| {
                     let (u1, u2) = (rng.uniform(), u(rng));
-                    m.sample_under_coat(wo, u1, u2, mode)
+                    m.sample_part(BsdfPart::UnderCoat, wo, u1, u2, mode)
                         .map_or(0.0, |bs| (bs.f.g * bs.wi.z.abs() / bs.pdf) as f64)
                 };
                 let w = under_weight(&mut rng);
@@ -593,8 +593,11 @@ fn a_narrow_coat_and_the_light_under_it_add_up_to_the_whole() {
             }
             let (split, split_se) = mean_se(split, split2);
             let (under, under_se) = mean_se(under, under2);
-            let (q, q_noise) =
-                integral_of(|wo, wi| m.eval_under_coat(wo, wi, mode).g as f64, wo, 100);
+            let (q, q_noise) = integral_of(
+                |wo, wi| m.eval_part(BsdfPart::UnderCoat, wo, wi, mode).g as f64,
+                wo,
+                100,
+            );
             println!(
                 "{name}, cos {cos_o}: whole {whole:.5} ± {whole_se:.5}, split {split:.5} ± \
                  {split_se:.5}; under the coat sampled {under:.5} ± {under_se:.5}, \

@@ -225,7 +225,7 @@ pub enum CoatStep {
     /// Along the coat's reflection: the ray to trace and how it was chosen.
     Reflect(Vec3, ChainVertex),
     /// The chain ends here and the light under the coat is gathered
-    /// ([`Material::eval_under_coat`]).
+    /// ([`crate::material::BsdfPart::UnderCoat`]).
     Under,
 }
 

@@ -80,6 +80,17 @@ pub enum Material {
     Interface,
 }
 
+/// The part of a BSDF that a photon estimate weighs with (see
+/// [`Material::narrow_coat`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BsdfPart {
+    #[default]
+    Whole,
+    /// Without a coat's direct reflection: the light that enters the layers and leaves
+    /// them again. The whole BSDF of an uncoated material.
+    UnderCoat,
+}
+
 /// A sampled direction with its BSDF value and pdf. For specular lobes `pdf` is the
 /// discrete probability of the lobe and `f` carries a matching 1/|cos| factor, so that
 /// `f |cos| / pdf` is the path weight in every case.
@@ -264,7 +275,7 @@ impl Material {
     /// base that is not (a varnish over a diffuse base): the photon integrators take
     /// its two parts apart ([`Layered::choose_coat_part`]). The coat's reflection goes
     /// on with the camera path, as a polished metal's does; the light under the coat
-    /// is gathered from the photons by [`Material::eval_under_coat`]. Gathered with
+    /// is gathered from the photons by [`BsdfPart::UnderCoat`]. Gathered with
     /// the whole BSDF, the coat's peak of about 1 / (π α²) turned the few photons that
     /// arrive near its mirror direction into fireflies (Bitterli's coffee, α = 0.001).
     pub fn narrow_coat(&self) -> Option<&Layered> {
@@ -278,30 +289,32 @@ impl Material {
         }
     }
 
-    /// [`eval_mode`](Self::eval_mode) without a coat's direct reflection (the whole
-    /// BSDF for uncoated materials).
-    pub fn eval_under_coat(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
-        match self {
-            Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } => {
-                layers.eval_under_coat(wo, wi, mode)
-            }
+    /// [`eval_mode`](Self::eval_mode) of one part of the BSDF.
+    pub fn eval_part(&self, part: BsdfPart, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
+        match (part, self) {
+            (
+                BsdfPart::UnderCoat,
+                Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers },
+            ) => layers.eval_under_coat(wo, wi, mode),
             _ => self.eval_mode(wo, wi, mode),
         }
     }
 
-    /// [`sample`](Self::sample) without a coat's direct reflection (`None` where the
-    /// coat reflects); the whole BSDF's sample for uncoated materials.
-    pub fn sample_under_coat(
+    /// [`sample`](Self::sample) of one part of the BSDF: under a coat, `None` where the
+    /// coat reflects.
+    pub fn sample_part(
         &self,
+        part: BsdfPart,
         wo: Vec3,
         u1: f32,
         u2: Vec2,
         mode: TransportMode,
     ) -> Option<BsdfSample> {
-        match self {
-            Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers } => {
-                layers.sample_under_coat(wo, u1, u2, mode)
-            }
+        match (part, self) {
+            (
+                BsdfPart::UnderCoat,
+                Material::CoatedDiffuse { layers } | Material::CoatedConductor { layers },
+            ) => layers.sample_under_coat(wo, u1, u2, mode),
             _ => self.sample(wo, u1, u2, mode),
         }
     }

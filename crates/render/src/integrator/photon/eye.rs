@@ -16,7 +16,7 @@ use crate::integrator::specular::{
     specular_bounce,
 };
 use crate::light::SceneSphere;
-use crate::material::{Material, TransportMode};
+use crate::material::{BsdfPart, Material, TransportMode};
 use crate::sampler::PixelSample;
 use crate::world::World;
 use radiant_math::INV_PI;
@@ -109,7 +109,7 @@ pub fn radiance(
             ray = hit.spawn_ray(wi);
             continue;
         }
-        let mut under_coat = false;
+        let mut part = BsdfPart::Whole;
         if settings.visualize == Visualize::None {
             l += beta * emitted;
             let (direct, direct_rays) =
@@ -127,7 +127,7 @@ pub fn radiance(
                         ray = hit.spawn_ray(wi);
                         continue;
                     }
-                    Some(CoatStep::Under) => under_coat = true,
+                    Some(CoatStep::Under) => part = BsdfPart::UnderCoat,
                 }
             }
         }
@@ -137,14 +137,8 @@ pub fn radiance(
             two_sided: material.transmits_diffusely(),
         };
         let wo = frame.to_local(wo_world);
-        let bsdf = |wi: Vec3| {
-            let wi = frame.to_local(wi);
-            if under_coat {
-                material.eval_under_coat(wo, wi, TransportMode::Radiance)
-            } else {
-                material.eval(wo, wi)
-            }
-        };
+        let bsdf =
+            |wi: Vec3| material.eval_part(part, wo, frame.to_local(wi), TransportMode::Radiance);
         let maps = ctx.maps;
         // Radiance reflected towards the viewer by the photons of one map near the point.
         let estimate = |map, skip_flags, neighbours: &mut _| {
@@ -163,8 +157,7 @@ pub fn radiance(
                 let at = ShadingPoint::new(&hit, material, wo_world);
                 let caustic = estimate(&maps.caustic, 0, &mut scratch.caustic);
                 let indirect = if settings.final_gather_samples > 0 {
-                    let (gathered, gather_rays) =
-                        final_gather(ctx, &at, under_coat, gather, scratch);
+                    let (gathered, gather_rays) = final_gather(ctx, &at, part, gather, scratch);
                     rays += gather_rays;
                     gathered
                 } else {
@@ -202,7 +195,7 @@ fn photon_dots(maps: &PhotonMaps, at: &EstimatePoint, radius: f32) -> Rgb {
 }
 
 /// Indirect diffuse light at a camera path's diffuse point by final gathering: rays
-/// sampled from the BSDF (without a narrow coat's reflection where `under_coat`) follow
+/// sampled from `part` of the BSDF (without a narrow coat's reflection under it) follow
 /// specular chains to a diffuse point y, where the light leaving y is next-event
 /// estimation plus the precomputed irradiance (global and caustic maps) times the
 /// diffuse reflectance. Emission reached by gather rays is not counted (next-event
@@ -211,7 +204,7 @@ fn photon_dots(maps: &PhotonMaps, at: &EstimatePoint, radius: f32) -> Rgb {
 fn final_gather(
     ctx: &EyeContext,
     at: &ShadingPoint,
-    under_coat: bool,
+    part: BsdfPart,
     gather: GatherStream,
     scratch: &mut EyeScratch,
 ) -> (Rgb, u32) {
@@ -226,12 +219,8 @@ fn final_gather(
         let mut s = PixelSample::for_stream(gather.kind, gather.seed, gather.key, j);
         let u_lobe = s.get_1d_if(material.uses_lobe_sample());
         let u_dir = s.get_2d();
-        let bs = if under_coat {
-            material.sample_under_coat(wo, u_lobe, u_dir, TransportMode::Radiance)
-        } else {
-            material.sample(wo, u_lobe, u_dir, TransportMode::Radiance)
-        };
-        let Some(bs) = bs else {
+        let Some(bs) = material.sample_part(part, wo, u_lobe, u_dir, TransportMode::Radiance)
+        else {
             continue;
         };
         let wi = frame.to_world(bs.wi);
@@ -265,7 +254,7 @@ fn final_gather(
             // Under a narrow coat the photons are weighed without the coat's reflection,
             // which the gather ray follows instead (the direct light above took the
             // whole BSDF).
-            let mut under_coat_y = false;
+            let mut part_y = BsdfPart::Whole;
             if let Some(layers) = mat_y.narrow_coat() {
                 match coat_step(&y, layers, &frame_y, wo_y_world, &mut s, &mut beta) {
                     None => break,
@@ -273,7 +262,7 @@ fn final_gather(
                         ray = y.spawn_ray(wi);
                         continue;
                     }
-                    Some(CoatStep::Under) => under_coat_y = true,
+                    Some(CoatStep::Under) => part_y = BsdfPart::UnderCoat,
                 }
             }
             let at = EstimatePoint {
@@ -289,12 +278,7 @@ fn final_gather(
                 // evaluated per photon (Jensen 2001, §7.5). An irradiance times the
                 // diffuse albedo, zero for a rough metal, would drop all of it.
                 let bsdf = |wi: Vec3| {
-                    let wi = frame_y.to_local(wi);
-                    if under_coat_y {
-                        mat_y.eval_under_coat(wo_y, wi, TransportMode::Radiance)
-                    } else {
-                        mat_y.eval(wo_y, wi)
-                    }
+                    mat_y.eval_part(part_y, wo_y, frame_y.to_local(wi), TransportMode::Radiance)
                 };
                 let estimate = |map, neighbours: &mut _| {
                     radiance_estimate(map, &at, maps.max_r2, settings.kernel, 0, neighbours, bsdf)

@@ -16,7 +16,7 @@ use crate::context::RenderContext;
 use crate::integrator::specular::{
     ChainVertex, CoatStep, chain_bounce, chain_end_direct, coat_step, glossy_direct,
 };
-use crate::material::{Material, TransportMode};
+use crate::material::{BsdfPart, Material, TransportMode};
 use crate::world::World;
 use radiant_math::color::Rgb;
 use radiant_math::{Frame, INV_PI};
@@ -41,7 +41,7 @@ pub struct VisiblePoint {
     pub lambertian: bool,
     /// The point gathers only the light under a narrow coat, whose own reflection
     /// the camera path follows instead ([`coat_step`]).
-    pub under_coat: bool,
+    pub part: BsdfPart,
     pub valid: bool,
 }
 
@@ -57,13 +57,12 @@ impl VisiblePoint {
 
     /// The BSDF that weighs a photon arriving from `wi` (world direction).
     pub fn bsdf(&self, wi: Vec3) -> Rgb {
-        let wi = self.frame.to_local(wi);
-        if self.under_coat {
-            self.material
-                .eval_under_coat(self.wo, wi, TransportMode::Radiance)
-        } else {
-            self.material.eval(self.wo, wi)
-        }
+        self.material.eval_part(
+            self.part,
+            self.wo,
+            self.frame.to_local(wi),
+            TransportMode::Radiance,
+        )
     }
 }
 
@@ -77,7 +76,7 @@ impl Default for VisiblePoint {
             beta: Rgb::BLACK,
             material: Material::Interface,
             lambertian: false,
-            under_coat: false,
+            part: BsdfPart::Whole,
             valid: false,
         }
     }
@@ -150,7 +149,7 @@ pub fn camera_sample(
             chain_end_direct(world, scene, &hit, material, &frame, wo_world, &mut sampler);
         out.rays += rays;
         out.ld += beta * direct;
-        let mut under_coat = false;
+        let mut part = BsdfPart::Whole;
         if let Some(layers) = material.narrow_coat() {
             match coat_step(&hit, layers, &frame, wo_world, &mut sampler, &mut beta) {
                 None => break,
@@ -162,7 +161,7 @@ pub fn camera_sample(
                     ray = hit.spawn_ray(wi);
                     continue;
                 }
-                Some(CoatStep::Under) => under_coat = true,
+                Some(CoatStep::Under) => part = BsdfPart::UnderCoat,
             }
         }
         out.vp = VisiblePoint {
@@ -179,7 +178,7 @@ pub fn camera_sample(
             lambertian: material.is_diffuse()
                 && (hit.ns == hit.ng || hit.ns == -hit.ng)
                 && wo.z != 0.0,
-            under_coat,
+            part,
             valid: true,
         };
         break;
