@@ -289,6 +289,16 @@ impl Material {
         }
     }
 
+    /// The BSDF's value is a Monte Carlo estimate, random walks between layers
+    /// (Guo, Hašan & Zhao 2018), and dear: estimates that would evaluate it for every photon
+    /// near a point evaluate it for a sample of them.
+    pub fn eval_is_estimated(&self) -> bool {
+        matches!(
+            self,
+            Material::CoatedDiffuse { .. } | Material::CoatedConductor { .. }
+        )
+    }
+
     /// [`eval_mode`](Self::eval_mode) of one part of the BSDF.
     pub fn eval_part(&self, part: BsdfPart, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
         match (part, self) {
