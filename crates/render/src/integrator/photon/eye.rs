@@ -4,7 +4,9 @@
 
 use glam::Vec3;
 
-use super::estimate::{EstimatePoint, PhotonMap, radiance_estimate, radiance_estimate_sampled};
+use super::estimate::{
+    ESTIMATED_EVALS, EstimatePoint, PhotonMap, radiance_estimate, radiance_estimate_sampled,
+};
 use super::kdtree::Neighbors;
 use super::record::FIRST_DIFFUSE;
 use super::settings::Visualize;
@@ -22,12 +24,6 @@ use crate::world::World;
 use radiant_math::INV_PI;
 use radiant_math::color::Rgb;
 use radiant_scene::SamplerKind;
-
-/// The photons per map for which an estimate on a layered surface evaluates the BSDF
-/// ([`radiance_estimate_sampled`]). Chosen by time to error on a Cornell box of
-/// varnished walls (docs/speed.md): from all of them (about 250) to 4 the CPU time falls
-/// 5.4× and the error rises 0.5 %; 1 saves little more.
-const ESTIMATED_EVALS: usize = 4;
 
 /// A radiance estimate's parameters at one point: the photons' BSDF is evaluated for
 /// all of them, or, where its value is itself a random walk

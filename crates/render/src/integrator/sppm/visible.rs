@@ -42,6 +42,9 @@ pub struct VisiblePoint {
     /// The point gathers only the light under a narrow coat, whose own reflection
     /// the camera path follows instead ([`coat_step`]).
     pub part: BsdfPart,
+    /// Chooses the photons whose BSDF value is evaluated where that value is a random
+    /// walk ([`Material::eval_is_estimated`]).
+    pub u_evals: f32,
     pub valid: bool,
 }
 
@@ -77,6 +80,7 @@ impl Default for VisiblePoint {
             material: Material::Interface,
             lambertian: false,
             part: BsdfPart::Whole,
+            u_evals: 0.0,
             valid: false,
         }
     }
@@ -179,6 +183,7 @@ pub fn camera_sample(
                 && (hit.ns == hit.ng || hit.ns == -hit.ng)
                 && wo.z != 0.0,
             part,
+            u_evals: sampler.get_1d_if(material.eval_is_estimated()),
             valid: true,
         };
         break;
