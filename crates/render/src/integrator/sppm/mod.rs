@@ -646,7 +646,10 @@ mod tests {
             }
         }
         for (m, w) in mean.into_iter().zip(whole.to_array()) {
-            assert!((m / w as f64 - 1.0).abs() < 2e-3, "{mean:?} against {whole:?}");
+            assert!(
+                (m / w as f64 - 1.0).abs() < 2e-3,
+                "{mean:?} against {whole:?}"
+            );
         }
         let few = PhotonGrid::build(photons(3, &mut rng), 1.0);
         vp.u_evals = 0.7;
