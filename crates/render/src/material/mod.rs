@@ -289,9 +289,9 @@ impl Material {
         }
     }
 
-    /// The BSDF's value is a Monte Carlo estimate, random walks between layers
-    /// (Guo, Hašan & Zhao 2018), and dear: estimates that would evaluate it for every photon
-    /// near a point evaluate it for a sample of them.
+    /// The BSDF's value is a Monte Carlo estimate (random walks between layers; Guo,
+    /// Hašan & Zhao 2018), and dear: photon estimates that would evaluate it for every
+    /// photon near a point evaluate it for a sample of them.
     pub fn eval_is_estimated(&self) -> bool {
         matches!(
             self,

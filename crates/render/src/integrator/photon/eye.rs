@@ -25,12 +25,11 @@ use radiant_math::INV_PI;
 use radiant_math::color::Rgb;
 use radiant_scene::SamplerKind;
 
-/// A radiance estimate's parameters at one point: the photons' BSDF is evaluated for
-/// all of them, or, where its value is itself a random walk
-/// ([`Material::eval_is_estimated`]), for [`ESTIMATED_EVALS`] chosen by `u_evals`.
-/// Evaluated for each of the 250 photons of a gather ray's endpoint, a varnished
-/// floor's walks were most of the photon mapper's time, for a noise the walks have
-/// anyway.
+/// A radiance estimate at one point. The BSDF is evaluated for every photon found or,
+/// where its value is itself a random walk ([`Material::eval_is_estimated`]), for
+/// [`ESTIMATED_EVALS`] of them chosen by `u_evals`. Evaluating a varnished floor's
+/// walks for each of the 250 photons at a gather ray's endpoint was most of the photon
+/// mapper's time, for a noise the walks have anyway.
 struct MapQuery<'a> {
     maps: &'a PhotonMaps,
     at: &'a EstimatePoint,
