@@ -131,24 +131,15 @@ pub fn radiance_estimate(
     nbrs: &mut Neighbors,
     f: impl Fn(Vec3) -> Rgb,
 ) -> Rgb {
-    let Some(disc) = Disc::find(map, at, max_r2, kernel, skip_flags, nbrs) else {
-        return Rgb::BLACK;
-    };
-    let mut sum = Rgb::BLACK;
-    for (i, d2) in nbrs.iter() {
-        let Some(w) = disc.weight(i, d2) else {
-            continue;
-        };
-        let ph = map.tree().get(i);
-        sum += f(ph.wi()) * map.power(ph) * w;
+    match Disc::find(map, at, max_r2, kernel, skip_flags, nbrs) {
+        Some(disc) => disc.sum(map, nbrs, f),
+        None => Rgb::BLACK,
     }
-    sum * disc.scale
 }
 
 /// [`radiance_estimate`] with the BSDF evaluated for at most `evals` of the photons
-/// (all of them where they are no more),
-/// for BSDFs whose evaluation is itself a Monte Carlo estimate (layered random walks)
-/// and dear: the photons are drawn by systematic sampling along their kernel-weighted
+/// (all of them where they are no more), for BSDFs whose evaluation is itself a Monte
+/// Carlo estimate (layered random walks) and dear: the photons are drawn by systematic sampling along their kernel-weighted
 /// powers from the one number `u` ([`SystematicDraw`]) and reweighted. The estimate
 /// stays unbiased over `u`; what it adds is the variation of f across the photons'
 /// directions, of the order of the walks' own noise for the broad BSDFs this serves.
@@ -182,12 +173,13 @@ pub fn radiance_estimate_sampled(
     if total <= 0.0 || !total.is_finite() {
         return Rgb::BLACK;
     }
-    // With no more photons than evaluations, all are evaluated.
-    let every = count <= evals;
+    if count <= evals {
+        return disc.sum(map, nbrs, f);
+    }
     let mut draw = SystematicDraw::new(total, evals, u);
     let mut sum = Rgb::BLACK;
     for (ph, weighted_power, q) in nbrs.iter().filter_map(|(i, d2)| share(i, d2)) {
-        let reweight = if every { 1.0 } else { draw.reweight(q) };
+        let reweight = draw.reweight(q);
         if reweight > 0.0 {
             sum += f(ph.wi()) * weighted_power * reweight;
         }
@@ -249,6 +241,19 @@ impl Disc {
             boundary: if full { nbrs.farthest() } else { None },
             scale: 1.0 / (norm * PI * r2),
         })
+    }
+
+    /// The estimate with the BSDF `f` evaluated for every photon found into `nbrs`.
+    fn sum(&self, map: &PhotonMap, nbrs: &Neighbors, f: impl Fn(Vec3) -> Rgb) -> Rgb {
+        let mut sum = Rgb::BLACK;
+        for (i, d2) in nbrs.iter() {
+            let Some(w) = self.weight(i, d2) else {
+                continue;
+            };
+            let ph = map.tree().get(i);
+            sum += f(ph.wi()) * map.power(ph) * w;
+        }
+        sum * self.scale
     }
 
     /// The kernel's weight of photon `i` at squared distance `d2`; `None` for the
