@@ -212,11 +212,8 @@ impl Disc {
         }
         map.tree().nearest_where(at.p, max_r2, nbrs, |ph| {
             ph.flags & skip_flags == 0
-                && if at.two_sided {
-                    ph.normal().dot(at.n).abs() > NORMAL_COS
-                } else {
-                    ph.wi().dot(at.n) > 0.0 && ph.normal().dot(at.n) > NORMAL_COS
-                }
+                && (at.two_sided || ph.arrives_from_side_of(at.n))
+                && ph.normal_within(at.n, NORMAL_COS, at.two_sided)
         });
         if nbrs.is_empty() {
             return None;

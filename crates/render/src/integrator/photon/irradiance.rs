@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::estimate::{EstimatePoint, PhotonMap, radiance_estimate};
 use super::kdtree::{self, KdPoint, KdTree, Neighbors};
-use super::record::{oct_decode, oct_encode};
+use super::record::{oct_cos_exceeds, oct_encode};
 use super::settings::Kernel;
 use radiant_math::color::Rgb;
 
@@ -131,7 +131,7 @@ impl IrradianceCache {
     /// with `at.n`; `nbrs` must ask for one neighbour.
     pub fn lookup(&self, at: &EstimatePoint, max_r2: f32, nbrs: &mut Neighbors) -> Option<Rgb> {
         self.tree.nearest_where(at.p, max_r2, nbrs, |pt| {
-            oct_decode(pt.n).dot(at.n) > NORMAL_COS
+            oct_cos_exceeds(pt.n, at.n, NORMAL_COS, false)
         });
         let (i, _) = nbrs.iter().next()?;
         Some(Rgb::from_array(self.tree.get(i).e))

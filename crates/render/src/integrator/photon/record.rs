@@ -91,6 +91,20 @@ impl Photon {
     pub fn normal(&self) -> Vec3 {
         oct_decode(self.n)
     }
+
+    /// Whether the photon came from the side of `n` (a positive cosine with it).
+    #[inline]
+    pub fn arrives_from_side_of(&self, n: Vec3) -> bool {
+        // The sign of the cosine needs no normalisation.
+        oct_point(self.wi).dot(n) > 0.0
+    }
+
+    /// Whether the cosine between the photon's normal and the unit vector `n` exceeds
+    /// `cos` (≥ 0); with `either_side`, its magnitude does.
+    #[inline]
+    pub fn normal_within(&self, n: Vec3, cos: f32, either_side: bool) -> bool {
+        oct_cos_exceeds(self.n, n, cos, either_side)
+    }
 }
 
 impl KdPoint for Photon {
@@ -174,6 +188,24 @@ pub fn oct_encode(v: Vec3) -> [u16; 2] {
 
 /// Inverse of [`oct_encode`] (a unit vector).
 pub fn oct_decode(e: [u16; 2]) -> Vec3 {
+    oct_point(e).normalize()
+}
+
+/// Whether the cosine between the direction `e` encodes and the unit vector `n` exceeds
+/// `cos` (≥ 0); with `either_side`, its magnitude does. Photon searches test this for
+/// every candidate, so it skips the square root and division of a normalisation:
+/// v·n / |v| > c is (v·n)² > c² |v|² with the sign of v·n.
+#[inline]
+pub fn oct_cos_exceeds(e: [u16; 2], n: Vec3, cos: f32, either_side: bool) -> bool {
+    let v = oct_point(e);
+    let d = v.dot(n);
+    (either_side || d > 0.0) && d * d > cos * cos * v.length_squared()
+}
+
+/// The point of the octahedron |x| + |y| + |z| = 1 that `e` encodes: the direction of
+/// [`oct_decode`], not yet normalised.
+#[inline]
+fn oct_point(e: [u16; 2]) -> Vec3 {
     let x = e[0] as f32 / 65535.0 * 2.0 - 1.0;
     let y = e[1] as f32 / 65535.0 * 2.0 - 1.0;
     let z = 1.0 - x.abs() - y.abs();
@@ -185,7 +217,7 @@ pub fn oct_decode(e: [u16; 2]) -> Vec3 {
     } else {
         (x, y)
     };
-    Vec3::new(x, y, z).normalize()
+    Vec3::new(x, y, z)
 }
 
 #[cfg(test)]
@@ -238,6 +270,44 @@ mod tests {
         for axis in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
             assert!(oct_decode(oct_encode(axis)).dot(axis) > 0.999_999);
         }
+    }
+
+    /// The cosine test without normalisation decides as the decoded unit vector's cosine
+    /// does, up to rounding at the threshold itself; and the side test as its sign.
+    #[test]
+    fn cosine_tests_agree_with_the_decoded_direction() {
+        let mut rng = Pcg32::new(5, 6);
+        let mut decided = [0usize; 2];
+        for _ in 0..100_000 {
+            let e = oct_encode(uniform_sphere(Vec2::new(rng.uniform(), rng.uniform())));
+            let n = uniform_sphere(Vec2::new(rng.uniform(), rng.uniform()));
+            let c = oct_decode(e).dot(n);
+            for cos in [0.0, 0.5, 0.7, 0.9] {
+                for either_side in [false, true] {
+                    let reference = if either_side { c.abs() } else { c };
+                    if (reference - cos).abs() < 1e-6 {
+                        continue;
+                    }
+                    let fast = oct_cos_exceeds(e, n, cos, either_side);
+                    assert_eq!(fast, reference > cos, "cos {c} against {cos}");
+                    decided[usize::from(fast)] += 1;
+                }
+            }
+            let raw = RawPhoton {
+                p: Vec3::ZERO,
+                power: Rgb::WHITE,
+                wi: oct_decode(e),
+                n: Vec3::Z,
+                bounces: 0,
+                flags: 0,
+            };
+            let ph = Photon::encode(&raw, 1.0);
+            if c.abs() > 1e-6 {
+                assert_eq!(ph.arrives_from_side_of(n), c > 0.0);
+            }
+        }
+        // Both answers occur often: the test is not vacuous.
+        assert!(decided.iter().all(|&k| k > 100_000), "{decided:?}");
     }
 
     #[test]
