@@ -19,9 +19,10 @@ use radiant_math::sampling::SystematicDraw;
 const NORMAL_COS: f32 = 0.7;
 
 /// The photons for which the photon mapper's estimate on a layered surface evaluates
-/// the BSDF, in each map ([`radiance_estimate_sampled`]). Chosen by time to error on a Cornell box of varnished walls (docs/speed.md): from
-/// all of them (about 250) to 4, the photon mapper's CPU time falls 5.4× and its error
-/// rises 0.5 %; 1 saves little more.
+/// the BSDF, in each map ([`radiance_estimate_sampled`]). Chosen by time to error on a
+/// Cornell box of varnished walls (docs/speed.md): from all of them (about 250) to 4,
+/// the photon mapper's CPU time falls 5.4× and its error rises 0.5 %; 1 saves little
+/// more.
 pub const ESTIMATED_EVALS: usize = 4;
 
 /// A set of stored photons in a kd-tree.
@@ -119,19 +120,26 @@ pub struct EstimatePoint {
     pub two_sided: bool,
 }
 
-/// Reflected radiance at `at` from `map`: the `nbrs.k()` nearest photons within
-/// `max_r2` (squared scene units) whose flags share nothing with `skip_flags`;
-/// `f(wi)` is the BSDF for the photon's incoming direction `wi` (world space).
+/// Which photons an estimate gathers and how it weights them.
+#[derive(Clone, Copy, Debug)]
+pub struct PhotonSearch {
+    /// The largest squared radius searched (squared scene units).
+    pub max_r2: f32,
+    pub kernel: Kernel,
+    /// Photons whose flags share a bit with these are left out.
+    pub skip_flags: u8,
+}
+
+/// Reflected radiance at `at` from `map`: the `nbrs.k()` nearest photons that `search`
+/// admits; `f(wi)` is the BSDF for the photon's incoming direction `wi` (world space).
 pub fn radiance_estimate(
     map: &PhotonMap,
     at: &EstimatePoint,
-    max_r2: f32,
-    kernel: Kernel,
-    skip_flags: u8,
+    search: PhotonSearch,
     nbrs: &mut Neighbors,
     f: impl Fn(Vec3) -> Rgb,
 ) -> Rgb {
-    match Disc::find(map, at, max_r2, kernel, skip_flags, nbrs) {
+    match Disc::find(map, at, search, nbrs) {
         Some(disc) => disc.sum(map, nbrs, f),
         None => Rgb::BLACK,
     }
@@ -139,23 +147,21 @@ pub fn radiance_estimate(
 
 /// [`radiance_estimate`] with the BSDF evaluated for at most `evals` of the photons
 /// (all of them where they are no more), for BSDFs whose evaluation is itself a Monte
-/// Carlo estimate (layered random walks) and dear: the photons are drawn by systematic sampling along their kernel-weighted
-/// powers from the one number `u` ([`SystematicDraw`]) and reweighted. The estimate
+/// Carlo estimate (layered random walks) and costly. The photons are drawn by
+/// systematic sampling along their kernel-weighted powers from the one number `u`
+/// ([`SystematicDraw`]) and reweighted. The estimate
 /// stays unbiased over `u`; what it adds is the variation of f across the photons'
 /// directions, of the order of the walks' own noise for the broad BSDFs this serves.
-#[allow(clippy::too_many_arguments)]
 pub fn radiance_estimate_sampled(
     map: &PhotonMap,
     at: &EstimatePoint,
-    max_r2: f32,
-    kernel: Kernel,
-    skip_flags: u8,
+    search: PhotonSearch,
     nbrs: &mut Neighbors,
     evals: usize,
     u: f32,
     f: impl Fn(Vec3) -> Rgb,
 ) -> Rgb {
-    let Some(disc) = Disc::find(map, at, max_r2, kernel, skip_flags, nbrs) else {
+    let Some(disc) = Disc::find(map, at, search, nbrs) else {
         return Rgb::BLACK;
     };
     let share = |i: u32, d2: f32| {
@@ -202,14 +208,17 @@ impl Disc {
     fn find(
         map: &PhotonMap,
         at: &EstimatePoint,
-        max_r2: f32,
-        kernel: Kernel,
-        skip_flags: u8,
+        search: PhotonSearch,
         nbrs: &mut Neighbors,
     ) -> Option<Disc> {
         if map.is_empty() {
             return None;
         }
+        let PhotonSearch {
+            max_r2,
+            kernel,
+            skip_flags,
+        } = search;
         map.tree().nearest_where(at.p, max_r2, nbrs, |ph| {
             ph.flags & skip_flags == 0
                 && (at.two_sided || ph.arrives_from_side_of(at.n))
@@ -272,6 +281,15 @@ mod tests {
     use super::*;
     use radiant_math::hash::Pcg32;
 
+    /// Every photon within `sqrt(max_r2)`, weighted by `kernel`.
+    fn search(max_r2: f32, kernel: Kernel) -> PhotonSearch {
+        PhotonSearch {
+            max_r2,
+            kernel,
+            skip_flags: 0,
+        }
+    }
+
     /// Photons of equal power spread uniformly over a plane: the estimate of irradiance
     /// (f = 1) converges to the density for every kernel.
     #[test]
@@ -306,8 +324,10 @@ mod tests {
                     n: Vec3::Y,
                     two_sided: false,
                 };
-                sum += radiance_estimate(&map, &at, 100.0, kernel, 0, &mut nbrs, |_| Rgb::WHITE).g
-                    as f64;
+                sum += radiance_estimate(&map, &at, search(100.0, kernel), &mut nbrs, |_| {
+                    Rgb::WHITE
+                })
+                .g as f64;
             }
             let mean = sum / queries as f64;
             // Each estimate has relative noise ~1/sqrt(k) = 7 %; the mean of 400 partly
@@ -350,12 +370,13 @@ mod tests {
         };
         for kernel in [Kernel::Disc, Kernel::Cone, Kernel::Epanechnikov] {
             let mut nbrs = Neighbors::new(200);
-            let whole = radiance_estimate(&map, &at, 4.0, kernel, 0, &mut nbrs, f);
+            let whole = radiance_estimate(&map, &at, search(4.0, kernel), &mut nbrs, f);
             let draws = 4096;
             let mut mean = [0.0f64; 3];
             for j in 0..draws {
                 let u = (j as f32 + 0.5) / draws as f32;
-                let e = radiance_estimate_sampled(&map, &at, 4.0, kernel, 0, &mut nbrs, 16, u, f);
+                let e =
+                    radiance_estimate_sampled(&map, &at, search(4.0, kernel), &mut nbrs, 16, u, f);
                 for (m, c) in mean.iter_mut().zip([e.r, e.g, e.b]) {
                     *m += c as f64 / draws as f64;
                 }
@@ -367,7 +388,8 @@ mod tests {
                 );
             }
             // One draw of 16 evaluations is off by the spread of f, not by orders.
-            let one = radiance_estimate_sampled(&map, &at, 4.0, kernel, 0, &mut nbrs, 16, 0.3, f);
+            let one =
+                radiance_estimate_sampled(&map, &at, search(4.0, kernel), &mut nbrs, 16, 0.3, f);
             assert!(
                 (one.r / whole.r - 1.0).abs() < 0.5,
                 "{one:?} against {whole:?}"
@@ -403,7 +425,9 @@ mod tests {
             two_sided: false,
         };
         assert_eq!(
-            radiance_estimate(&map, &at, 1.0, Kernel::Disc, 0, &mut nbrs, |_| Rgb::WHITE),
+            radiance_estimate(&map, &at, search(1.0, Kernel::Disc), &mut nbrs, |_| {
+                Rgb::WHITE
+            }),
             Rgb::BLACK
         );
     }

@@ -5,7 +5,8 @@
 use glam::Vec3;
 
 use super::estimate::{
-    ESTIMATED_EVALS, EstimatePoint, PhotonMap, radiance_estimate, radiance_estimate_sampled,
+    ESTIMATED_EVALS, EstimatePoint, PhotonMap, PhotonSearch, radiance_estimate,
+    radiance_estimate_sampled,
 };
 use super::kdtree::Neighbors;
 use super::record::FIRST_DIFFUSE;
@@ -61,21 +62,14 @@ impl<'a> MapQuery<'a> {
         nbrs: &mut Neighbors,
         f: impl Fn(Vec3) -> Rgb,
     ) -> Rgb {
-        let (r2, kernel) = (self.maps.max_r2, self.maps.settings.kernel);
+        let search = PhotonSearch {
+            skip_flags,
+            ..self.maps.search()
+        };
         if self.sampled {
-            radiance_estimate_sampled(
-                map,
-                self.at,
-                r2,
-                kernel,
-                skip_flags,
-                nbrs,
-                ESTIMATED_EVALS,
-                self.u_evals,
-                f,
-            )
+            radiance_estimate_sampled(map, self.at, search, nbrs, ESTIMATED_EVALS, self.u_evals, f)
         } else {
-            radiance_estimate(map, self.at, r2, kernel, skip_flags, nbrs, f)
+            radiance_estimate(map, self.at, search, nbrs, f)
         }
     }
 }
@@ -346,28 +340,13 @@ fn final_gather(
 /// The irradiance a gather ray reads where it lands at `at`: that of the nearest
 /// precomputed point, or, with none near, an estimate from both maps there.
 pub fn gathered_irradiance(maps: &PhotonMaps, at: &EstimatePoint, scratch: &mut EyeScratch) -> Rgb {
-    let settings = &maps.settings;
     maps.irradiance
         .as_ref()
         .and_then(|c| c.lookup(at, maps.max_r2, &mut scratch.nearest))
         .unwrap_or_else(|| {
             let one = |_| Rgb::WHITE;
-            radiance_estimate(
-                &maps.global,
-                at,
-                maps.max_r2,
-                settings.kernel,
-                0,
-                &mut scratch.global,
-                one,
-            ) + radiance_estimate(
-                &maps.caustic,
-                at,
-                maps.max_r2,
-                settings.kernel,
-                0,
-                &mut scratch.caustic,
-                one,
-            )
+            let search = maps.search();
+            radiance_estimate(&maps.global, at, search, &mut scratch.global, one)
+                + radiance_estimate(&maps.caustic, at, search, &mut scratch.caustic, one)
         })
 }

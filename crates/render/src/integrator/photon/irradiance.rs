@@ -8,7 +8,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::estimate::{EstimatePoint, PhotonMap, radiance_estimate};
+use super::estimate::{EstimatePoint, PhotonMap, PhotonSearch, radiance_estimate};
 use super::kdtree::{self, KdPoint, KdTree, Neighbors};
 use super::record::{oct_cos_exceeds, oct_encode};
 use super::settings::Kernel;
@@ -76,6 +76,11 @@ impl IrradianceCache {
         stop: &(dyn Fn() -> bool + Sync),
     ) -> Option<IrradianceCache> {
         let photons = global.photons();
+        let search = PhotonSearch {
+            max_r2,
+            kernel,
+            skip_flags: 0,
+        };
         let points: Vec<IrradiancePoint> = photons
             .par_chunks(256 * STRIDE)
             .flat_map_iter(|chunk| {
@@ -93,12 +98,9 @@ impl IrradianceCache {
                             n: ph.normal(),
                             two_sided: false,
                         };
-                        let e =
-                            radiance_estimate(global, &at, max_r2, kernel, 0, &mut g, |_| {
-                                Rgb::WHITE
-                            }) + radiance_estimate(caustic, &at, max_r2, kernel, 0, &mut c, |_| {
-                                Rgb::WHITE
-                            });
+                        let one = |_| Rgb::WHITE;
+                        let e = radiance_estimate(global, &at, search, &mut g, one)
+                            + radiance_estimate(caustic, &at, search, &mut c, one);
                         IrradiancePoint {
                             p: ph.p,
                             n: oct_encode(at.n),

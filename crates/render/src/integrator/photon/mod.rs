@@ -37,7 +37,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 
-pub use estimate::{EstimatePoint, PhotonMap};
+pub use estimate::{EstimatePoint, PhotonMap, PhotonSearch};
 pub use integrator::PhotonMapIntegrator;
 pub use irradiance::IrradianceCache;
 pub use kdtree::{KdPoint, KdTree, Neighbors};
@@ -117,6 +117,16 @@ pub struct PhotonMaps {
 }
 
 impl PhotonMaps {
+    /// The search of this render's estimates: every photon within the maximum radius,
+    /// weighted by the settings' kernel.
+    pub fn search(&self) -> PhotonSearch {
+        PhotonSearch {
+            max_r2: self.max_r2,
+            kernel: self.settings.kernel,
+            skip_flags: 0,
+        }
+    }
+
     /// Traces both photon passes and builds the maps. Deterministic for a given seed at
     /// any thread count. Stops early when `progress` is cancelled, and then leaves the maps
     /// empty: nothing is rendered from them.
