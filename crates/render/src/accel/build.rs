@@ -7,8 +7,10 @@
 //! partitioned in place. Large ranges are binned in parallel and subtrees built with
 //! `rayon::join`. The binary tree is then collapsed into wide nodes by repeatedly
 //! opening the child with the largest surface area (as in Wald et al., "Getting Rid of
-//! Packets", IEEE RT 2008, and Embree's BVH4), and flattened depth-first.
+//! Packets", IEEE RT 2008, and Embree's BVH4), and flattened depth-first. Small ranges
+//! that span much of the scene may instead be built bottom-up (cluster.rs).
 
+use super::cluster::{CLUSTER_MAX, Costs, RayModel, cluster_range};
 use super::node::{WIDTH, WideNode};
 use crate::geometry::Aabb;
 use glam::Vec3;
@@ -27,10 +29,10 @@ pub(crate) struct BuildSettings {
 
 /// One primitive reference during the build.
 #[derive(Clone, Copy, Debug)]
-struct PrimRef {
-    min: Vec3,
+pub(crate) struct PrimRef {
+    pub min: Vec3,
     id: u32,
-    max: Vec3,
+    pub max: Vec3,
 }
 
 impl PrimRef {
@@ -90,7 +92,15 @@ pub(crate) fn build_binary(
     if refs.is_empty() {
         return (None, Vec::new());
     }
-    let root = build_range(&mut refs, 0, 0, settings);
+    let scene = refs.iter().fold(Aabb::EMPTY, |b, r| Aabb {
+        min: b.min.min(r.min),
+        max: b.max.max(r.max),
+    });
+    let costs = Costs {
+        settings,
+        rays: RayModel::inside(&scene),
+    };
+    let root = build_range(&mut refs, 0, 0, &costs);
     (Some(root), refs.iter().map(|r| r.id).collect())
 }
 
@@ -241,17 +251,47 @@ fn partition(refs: &mut [PrimRef], goes_left: impl Fn(&PrimRef) -> bool) -> usiz
     i
 }
 
-fn build_range(refs: &mut [PrimRef], offset: u32, depth: u32, s: &BuildSettings) -> BuildNode {
+fn build_range(refs: &mut [PrimRef], offset: u32, depth: u32, c: &Costs) -> BuildNode {
     let n = refs.len();
     let (bounds, centroids) = range_bounds(refs);
+    if n == 1 {
+        return BuildNode::Leaf {
+            bounds,
+            start: offset,
+            count: 1,
+        };
+    }
+    // Small ranges at the scale of the scene's rays are also built bottom-up, and the
+    // tree the interior ray model finds cheaper is kept (cluster.rs).
+    if n <= CLUSTER_MAX && depth + n as u32 <= MAX_DEPTH && c.rays.is_interior_scale(&bounds) {
+        let mut clustered = refs.to_vec();
+        let (bottom_up, bottom_up_cost) = cluster_range(&mut clustered, offset, c);
+        let top_down = split_range(refs, offset, depth, c, bounds, centroids);
+        if bottom_up_cost < c.tree_cost(&top_down) {
+            refs.copy_from_slice(&clustered);
+            return bottom_up;
+        }
+        return top_down;
+    }
+    split_range(refs, offset, depth, c, bounds, centroids)
+}
+
+/// Top-down: the best binned SAH split of the range (or a leaf), then its halves.
+fn split_range(
+    refs: &mut [PrimRef],
+    offset: u32,
+    depth: u32,
+    c: &Costs,
+    bounds: Aabb,
+    centroids: Aabb,
+) -> BuildNode {
+    let s = c.settings;
+    let n = refs.len();
     let leaf = BuildNode::Leaf {
         bounds,
         start: offset,
         count: n as u32,
     };
-    if n == 1 {
-        return leaf;
-    }
     let leaf_cost = n.div_ceil(s.leaf_block as usize) as f32;
     // Near the depth bound (or with all centroids coincident) fall back to halving
     // the range, which reaches single primitives within log2(n) more levels.
@@ -291,13 +331,13 @@ fn build_range(refs: &mut [PrimRef], offset: u32, depth: u32, s: &BuildSettings)
     let right_offset = offset + split_at as u32;
     let (l, r) = if n >= PARALLEL_MIN {
         rayon::join(
-            || build_range(left, offset, depth + 1, s),
-            || build_range(right, right_offset, depth + 1, s),
+            || build_range(left, offset, depth + 1, c),
+            || build_range(right, right_offset, depth + 1, c),
         )
     } else {
         (
-            build_range(left, offset, depth + 1, s),
-            build_range(right, right_offset, depth + 1, s),
+            build_range(left, offset, depth + 1, c),
+            build_range(right, right_offset, depth + 1, c),
         )
     };
     BuildNode::Inner {

@@ -13,6 +13,7 @@ mod avx;
 mod bench;
 mod build;
 mod bvh;
+mod cluster;
 pub mod displaced_sphere;
 mod node;
 mod traverse;

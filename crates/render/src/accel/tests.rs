@@ -407,3 +407,273 @@ fn worst_case_chain_is_exact(levels: usize, stack: super::traverse::StackSize) {
     }
     assert!(hits > 100, "{levels} levels: {hits}");
 }
+
+/// The Cornell box (shared/scenes.md: five walls, the light 0.1 mm under the ceiling,
+/// two blocks of five faces), scaled by `scale` and moved by `offset`, every quad as two
+/// triangles; the first 12 triangles are the walls' and the light's, pairwise.
+fn cornell_box(offset: Vec3, scale: f32) -> Vec<[Vec3; 3]> {
+    let p = |x: f32, y: f32, z: f32| offset + scale * Vec3::new(x, y, z);
+    let quads = [
+        [
+            [552.8, 0., 0.],
+            [0., 0., 0.],
+            [0., 0., 559.2],
+            [549.6, 0., 559.2],
+        ],
+        [
+            [556., 548.8, 0.],
+            [556., 548.8, 559.2],
+            [0., 548.8, 559.2],
+            [0., 548.8, 0.],
+        ],
+        [
+            [549.6, 0., 559.2],
+            [0., 0., 559.2],
+            [0., 548.8, 559.2],
+            [556., 548.8, 559.2],
+        ],
+        [
+            [0., 0., 559.2],
+            [0., 0., 0.],
+            [0., 548.8, 0.],
+            [0., 548.8, 559.2],
+        ],
+        [
+            [552.8, 0., 0.],
+            [549.6, 0., 559.2],
+            [556., 548.8, 559.2],
+            [556., 548.8, 0.],
+        ],
+        [
+            [343., 548.7, 227.],
+            [343., 548.7, 332.],
+            [213., 548.7, 332.],
+            [213., 548.7, 227.],
+        ],
+        [
+            [130., 165., 65.],
+            [82., 165., 225.],
+            [240., 165., 272.],
+            [290., 165., 114.],
+        ],
+        [
+            [290., 0., 114.],
+            [290., 165., 114.],
+            [240., 165., 272.],
+            [240., 0., 272.],
+        ],
+        [
+            [130., 0., 65.],
+            [130., 165., 65.],
+            [290., 165., 114.],
+            [290., 0., 114.],
+        ],
+        [
+            [82., 0., 225.],
+            [82., 165., 225.],
+            [130., 165., 65.],
+            [130., 0., 65.],
+        ],
+        [
+            [240., 0., 272.],
+            [240., 165., 272.],
+            [82., 165., 225.],
+            [82., 0., 225.],
+        ],
+        [
+            [423., 330., 247.],
+            [265., 330., 296.],
+            [314., 330., 456.],
+            [472., 330., 406.],
+        ],
+        [
+            [423., 0., 247.],
+            [423., 330., 247.],
+            [472., 330., 406.],
+            [472., 0., 406.],
+        ],
+        [
+            [472., 0., 406.],
+            [472., 330., 406.],
+            [314., 330., 456.],
+            [314., 0., 456.],
+        ],
+        [
+            [314., 0., 456.],
+            [314., 330., 456.],
+            [265., 330., 296.],
+            [265., 0., 296.],
+        ],
+        [
+            [265., 0., 296.],
+            [265., 330., 296.],
+            [423., 330., 247.],
+            [423., 0., 247.],
+        ],
+    ];
+    quads
+        .iter()
+        .flat_map(|q| {
+            let [a, b, c, d] = q.map(|v| p(v[0], v[1], v[2]));
+            [[a, b, c], [a, c, d]]
+        })
+        .collect()
+}
+
+/// The leaves of a binary build tree: each one's box and the primitives in its range.
+fn build_leaves(node: &super::build::BuildNode, order: &[u32], out: &mut Vec<(Aabb, Vec<u32>)>) {
+    use super::build::BuildNode;
+    match node {
+        BuildNode::Leaf {
+            bounds,
+            start,
+            count,
+        } => out.push((
+            *bounds,
+            order[*start as usize..(*start + *count) as usize].to_vec(),
+        )),
+        BuildNode::Inner { children, .. } => {
+            build_leaves(&children[0], order, out);
+            build_leaves(&children[1], order, out);
+        }
+    }
+}
+
+/// In the Cornell box every leaf box the top-down build makes spans the room, and rays
+/// start inside it: under the interior ray model the bottom-up tree is cheaper, and in
+/// it each of the five walls is a leaf of its own, a slab entered only by the rays that
+/// reach it. The same leaves at any scale and offset, and every leaf holds exactly its
+/// range.
+#[test]
+fn the_cornell_boxs_walls_are_leaves_of_their_own_at_any_scale() {
+    let settings = super::build::BuildSettings {
+        leaf_block: 4,
+        max_leaf: 8,
+        cost_traversal: 1.0,
+    };
+    let mut first: Option<Vec<Vec<u32>>> = None;
+    for (offset, scale) in [
+        (Vec3::ZERO, 1.0),
+        (Vec3::new(-3e-3, 2e-3, 7e-3), 1e-5),
+        (Vec3::new(4e6, -9e6, 2e6), 1e4),
+    ] {
+        let tris = cornell_box(offset, scale);
+        let (root, order) = super::build::build_binary(&tri_bounds(&tris), &settings);
+        let mut leaves = Vec::new();
+        build_leaves(&root.expect("a tree"), &order, &mut leaves);
+        let mut seen = [false; 32];
+        for (bounds, prims) in &leaves {
+            assert!(prims.len() <= 8);
+            for &i in prims {
+                assert!(!std::mem::replace(&mut seen[i as usize], true));
+                let b = Aabb::from_points(&tris[i as usize]);
+                assert!(bounds.min.cmple(b.min).all() && bounds.max.cmpge(b.max).all());
+            }
+        }
+        assert!(seen.iter().all(|&s| s));
+        for wall in 0..5u32 {
+            let (bounds, prims) = leaves
+                .iter()
+                .find(|(_, p)| p.contains(&(2 * wall)))
+                .expect("every triangle is in a leaf");
+            assert_eq!(prims.len(), 2, "wall {wall} at scale {scale}: {prims:?}");
+            assert!(prims.contains(&(2 * wall + 1)));
+            // Flat but for the measured box's out-of-plane left wall (6.4 mm).
+            let thickness = bounds.diagonal().min_element();
+            assert!(thickness <= 6.5 * scale, "wall {wall}: {thickness}");
+        }
+        let mut shape: Vec<Vec<u32>> = leaves.into_iter().map(|(_, p)| p).collect();
+        shape.iter_mut().for_each(|p| p.sort());
+        shape.sort();
+        match &first {
+            None => first = Some(shape),
+            Some(f) => assert_eq!(&shape, f, "scale {scale}"),
+        }
+    }
+}
+
+/// The Cornell box's tree against brute force, for rays from points on its surfaces (as a
+/// path tracer casts them), for rays along the floor, and at two scales.
+#[test]
+fn the_cornell_box_built_bottom_up_equals_brute_force() {
+    let mut rng = Pcg32::new(5, 3);
+    for (offset, scale) in [(Vec3::ZERO, 1.0), (Vec3::new(-4e3, 1e3, 2e3), 0.01)] {
+        let tris = cornell_box(offset, scale);
+        let tbvh = TriangleBvh::from_soup(&tris);
+        let mut hits = 0;
+        for i in 0..20_000 {
+            let t = tris[(rng.next_u32() % 32) as usize];
+            let u = Vec2::new(rng.uniform(), rng.uniform());
+            let b = radiant_math::sampling::uniform_triangle(u);
+            let on = t[0] * b[0] + t[1] * b[1] + t[2] * b[2];
+            let d = uniform_sphere(Vec2::new(rng.uniform(), rng.uniform()));
+            let ray = match i % 4 {
+                // Along the floor's edge at the right wall, and across the floor.
+                0 => Ray::new(
+                    offset + scale * Vec3::new(0.0, 0.0, 559.2 * rng.uniform()),
+                    Vec3::X,
+                ),
+                _ => Ray::new(on + d * (1e-3 * scale), d),
+            };
+            for t_max in [f32::INFINITY, 300.0 * scale] {
+                let expect = brute_closest(&tris, &ray, t_max);
+                assert_eq!(
+                    tbvh.intersect(&ray, t_max).map(|h| h.t),
+                    expect.map(|e| e.0)
+                );
+                assert_eq!(tbvh.occluded(&ray, t_max), expect.is_some());
+                hits += usize::from(expect.is_some());
+            }
+        }
+        assert!(hits > 20_000, "{hits}");
+    }
+}
+
+/// The interior ray model's weight: the surface area heuristic for boxes small against the
+/// scene, twice it for the scene's own box (every ray starts in it), the area alone in a
+/// flat scene, and only ratios of scene and box: the same at any scale.
+#[test]
+fn the_interior_ray_model_weighs_boxes_by_area_and_by_volume_in_chords() {
+    use super::cluster::RayModel;
+    let cube = |min: Vec3, side: f32| Aabb {
+        min,
+        max: min + Vec3::splat(side),
+    };
+    let room = Aabb {
+        min: Vec3::ZERO,
+        max: Vec3::new(4.0, 3.0, 5.0),
+    };
+    let model = RayModel::inside(&room);
+    let small = cube(Vec3::splat(1.0), 1e-3);
+    assert!((model.weight(&small) / small.surface_area() - 1.0).abs() < 1e-3);
+    assert!(!model.is_interior_scale(&small));
+    assert!((model.weight(&room) / room.surface_area() - 2.0).abs() < 1e-6);
+    assert!(model.is_interior_scale(&room));
+    // A flat box has no volume, whatever its size.
+    let slab = Aabb {
+        min: Vec3::ZERO,
+        max: Vec3::new(4.0, 0.0, 5.0),
+    };
+    assert_eq!(model.weight(&slab), slab.surface_area());
+    let flat = RayModel::inside(&slab);
+    assert_eq!(flat.weight(&room), room.surface_area());
+    assert!(!flat.is_interior_scale(&room));
+    let half = cube(Vec3::ZERO, 1.5);
+    for (offset, k) in [
+        (Vec3::new(1e3, -2e3, 5e2), 100.0f32),
+        (Vec3::splat(-1e-2), 1e-3),
+    ] {
+        let at = |b: &Aabb| Aabb {
+            min: offset + k * b.min,
+            max: offset + k * b.max,
+        };
+        let scaled = RayModel::inside(&at(&room));
+        let ratio = |m: &RayModel, a: &Aabb, b: &Aabb| m.weight(a) / m.weight(b);
+        let expect = ratio(&model, &half, &slab);
+        let got = ratio(&scaled, &at(&half), &at(&slab));
+        assert!(
+            (got / expect - 1.0).abs() < 1e-3,
+            "{got} against {expect} at scale {k}"
+        );
+    }
+}
