@@ -92,13 +92,9 @@ pub(crate) fn build_binary(
     if refs.is_empty() {
         return (None, Vec::new());
     }
-    let scene = refs.iter().fold(Aabb::EMPTY, |b, r| Aabb {
-        min: b.min.min(r.min),
-        max: b.max.max(r.max),
-    });
     let costs = Costs {
         settings,
-        rays: RayModel::inside(&scene),
+        rays: RayModel::inside(&range_bounds(&refs).0),
     };
     let root = build_range(&mut refs, 0, 0, &costs);
     (Some(root), refs.iter().map(|r| r.id).collect())

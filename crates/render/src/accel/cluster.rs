@@ -50,8 +50,7 @@ pub(crate) struct RayModel {
 
 impl RayModel {
     pub fn inside(scene: &Aabb) -> RayModel {
-        let d = scene.diagonal();
-        let volume = d.x * d.y * d.z;
+        let volume = volume(scene);
         let w = scene.surface_area() / volume;
         RayModel {
             volume_weight: if volume > 0.0 && w.is_finite() {
@@ -67,16 +66,20 @@ impl RayModel {
     /// top-down binned build stands (a bottom-up build of every small range made a
     /// million-triangle mesh's closest hits 4–9 % slower).
     pub fn is_interior_scale(&self, b: &Aabb) -> bool {
-        let d = (b.max - b.min).max(Vec3::ZERO);
-        10.0 * self.volume_weight * d.x * d.y * d.z >= b.surface_area()
+        10.0 * self.volume_weight * volume(b) >= b.surface_area()
     }
 
     /// A(B) + (4 / ℓ) Vol(B): proportional to the probability that a ray enters `b`.
     #[inline]
     pub fn weight(&self, b: &Aabb) -> f32 {
-        let d = (b.max - b.min).max(Vec3::ZERO);
-        b.surface_area() + self.volume_weight * d.x * d.y * d.z
+        b.surface_area() + self.volume_weight * volume(b)
     }
+}
+
+/// The volume of a box (zero for an empty or flat one).
+fn volume(b: &Aabb) -> f32 {
+    let d = (b.max - b.min).max(Vec3::ZERO);
+    d.x * d.y * d.z
 }
 
 /// The build's settings with the ray model that weighs boxes in the choice between a
@@ -87,20 +90,24 @@ pub(crate) struct Costs<'a> {
 }
 
 impl Costs<'_> {
-    /// The expected cost of a binary tree, unnormalised: each inner node's weight times
-    /// the cost of a visit, plus each leaf's weight times its block tests.
+    /// The expected cost of a binary tree, unnormalised: the sum of its nodes' costs.
     pub fn tree_cost(&self, node: &BuildNode) -> f32 {
-        let s = self.settings;
         match node {
-            BuildNode::Leaf { bounds, count, .. } => {
-                self.rays.weight(bounds) * count.div_ceil(s.leaf_block) as f32
-            }
+            BuildNode::Leaf { bounds, count, .. } => self.leaf(bounds, *count),
             BuildNode::Inner { bounds, children } => {
-                s.cost_traversal * self.rays.weight(bounds)
-                    + self.tree_cost(&children[0])
-                    + self.tree_cost(&children[1])
+                self.inner(bounds) + self.tree_cost(&children[0]) + self.tree_cost(&children[1])
             }
         }
+    }
+
+    /// A leaf's cost: its weight times its block tests.
+    fn leaf(&self, bounds: &Aabb, count: u32) -> f32 {
+        self.rays.weight(bounds) * count.div_ceil(self.settings.leaf_block) as f32
+    }
+
+    /// An inner node's own cost: its weight times the cost of a visit.
+    fn inner(&self, bounds: &Aabb) -> f32 {
+        self.settings.cost_traversal * self.rays.weight(bounds)
     }
 }
 
@@ -212,12 +219,11 @@ pub(crate) fn cluster_range(refs: &mut [PrimRef], offset: u32, c: &Costs) -> (Bu
 /// (in block intersections, unnormalised: weight times expected work).
 /// Assigns ranges in the depth-first order `cluster_range` laid the primitives out in.
 fn cut(tree: &[Merge], t: u32, next: &mut u32, c: &Costs) -> (BuildNode, f32, u32) {
-    let s = c.settings;
     match tree[t as usize] {
         Merge::Prim(_, bounds) => {
             let start = *next;
             *next += 1;
-            let cost = c.rays.weight(&bounds);
+            let cost = c.leaf(&bounds, 1);
             (
                 BuildNode::Leaf {
                     bounds,
@@ -233,10 +239,9 @@ fn cut(tree: &[Merge], t: u32, next: &mut u32, c: &Costs) -> (BuildNode, f32, u3
             let (l, lc, ln) = cut(tree, a, next, c);
             let (r, rc, rn) = cut(tree, b, next, c);
             let count = ln + rn;
-            let area = c.rays.weight(&bounds);
-            let split_cost = s.cost_traversal * area + lc + rc;
-            let leaf_cost = area * count.div_ceil(s.leaf_block) as f32;
-            if count <= s.max_leaf && leaf_cost <= split_cost {
+            let split_cost = c.inner(&bounds) + lc + rc;
+            let leaf_cost = c.leaf(&bounds, count);
+            if count <= c.settings.max_leaf && leaf_cost <= split_cost {
                 (
                     BuildNode::Leaf {
                         bounds,

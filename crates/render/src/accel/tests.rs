@@ -408,116 +408,34 @@ fn worst_case_chain_is_exact(levels: usize, stack: super::traverse::StackSize) {
     assert!(hits > 100, "{levels} levels: {hits}");
 }
 
-/// The Cornell box (shared/scenes.md: five walls, the light 0.1 mm under the ceiling,
-/// two blocks of five faces), scaled by `scale` and moved by `offset`, every quad as two
-/// triangles; the first 12 triangles are the walls' and the light's, pairwise.
-fn cornell_box(offset: Vec3, scale: f32) -> Vec<[Vec3; 3]> {
-    let p = |x: f32, y: f32, z: f32| offset + scale * Vec3::new(x, y, z);
-    let quads = [
-        [
-            [552.8, 0., 0.],
-            [0., 0., 0.],
-            [0., 0., 559.2],
-            [549.6, 0., 559.2],
-        ],
-        [
-            [556., 548.8, 0.],
-            [556., 548.8, 559.2],
-            [0., 548.8, 559.2],
-            [0., 548.8, 0.],
-        ],
-        [
-            [549.6, 0., 559.2],
-            [0., 0., 559.2],
-            [0., 548.8, 559.2],
-            [556., 548.8, 559.2],
-        ],
-        [
-            [0., 0., 559.2],
-            [0., 0., 0.],
-            [0., 548.8, 0.],
-            [0., 548.8, 559.2],
-        ],
-        [
-            [552.8, 0., 0.],
-            [549.6, 0., 559.2],
-            [556., 548.8, 559.2],
-            [556., 548.8, 0.],
-        ],
-        [
-            [343., 548.7, 227.],
-            [343., 548.7, 332.],
-            [213., 548.7, 332.],
-            [213., 548.7, 227.],
-        ],
-        [
-            [130., 165., 65.],
-            [82., 165., 225.],
-            [240., 165., 272.],
-            [290., 165., 114.],
-        ],
-        [
-            [290., 0., 114.],
-            [290., 165., 114.],
-            [240., 165., 272.],
-            [240., 0., 272.],
-        ],
-        [
-            [130., 0., 65.],
-            [130., 165., 65.],
-            [290., 165., 114.],
-            [290., 0., 114.],
-        ],
-        [
-            [82., 0., 225.],
-            [82., 165., 225.],
-            [130., 165., 65.],
-            [130., 0., 65.],
-        ],
-        [
-            [240., 0., 272.],
-            [240., 165., 272.],
-            [82., 165., 225.],
-            [82., 0., 225.],
-        ],
-        [
-            [423., 330., 247.],
-            [265., 330., 296.],
-            [314., 330., 456.],
-            [472., 330., 406.],
-        ],
-        [
-            [423., 0., 247.],
-            [423., 330., 247.],
-            [472., 330., 406.],
-            [472., 0., 406.],
-        ],
-        [
-            [472., 0., 406.],
-            [472., 330., 406.],
-            [314., 330., 456.],
-            [314., 0., 456.],
-        ],
-        [
-            [314., 0., 456.],
-            [314., 330., 456.],
-            [265., 330., 296.],
-            [265., 0., 296.],
-        ],
-        [
-            [265., 0., 296.],
-            [265., 330., 296.],
-            [423., 330., 247.],
-            [423., 0., 247.],
-        ],
-    ];
-    quads
+/// The canonical Cornell box's triangles (`radiant_scene::builtin::cornell_box`), scaled
+/// by `scale` and moved by `offset`, each with the index of the shape it belongs to: the
+/// five walls are shapes 0 to 4, two triangles each.
+fn cornell_box(offset: Vec3, scale: f32) -> (Vec<[Vec3; 3]>, Vec<usize>) {
+    use radiant_scene::Geometry;
+    let mut tris = Vec::new();
+    let mut shape_of = Vec::new();
+    for (shape, desc) in radiant_scene::builtin::cornell_box()
+        .shapes
         .iter()
-        .flat_map(|q| {
-            let [a, b, c, d] = q.map(|v| p(v[0], v[1], v[2]));
-            [[a, b, c], [a, c, d]]
-        })
-        .collect()
+        .enumerate()
+    {
+        let Geometry::TriangleMesh {
+            positions, indices, ..
+        } = &desc.geometry
+        else {
+            continue;
+        };
+        for t in indices.chunks(3) {
+            tris.push(
+                [0, 1, 2].map(|k| {
+                    offset + scale * desc.render_from_object.point(positions[t[k] as usize])
+                }),
+            );
+            shape_of.push(shape);
+        }
+    }
+    (tris, shape_of)
 }
 
 /// The leaves of a binary build tree: each one's box and the primitives in its range.
@@ -557,11 +475,11 @@ fn the_cornell_boxs_walls_are_leaves_of_their_own_at_any_scale() {
         (Vec3::new(-3e-3, 2e-3, 7e-3), 1e-5),
         (Vec3::new(4e6, -9e6, 2e6), 1e4),
     ] {
-        let tris = cornell_box(offset, scale);
+        let (tris, shape_of) = cornell_box(offset, scale);
         let (root, order) = super::build::build_binary(&tri_bounds(&tris), &settings);
         let mut leaves = Vec::new();
         build_leaves(&root.expect("a tree"), &order, &mut leaves);
-        let mut seen = [false; 32];
+        let mut seen = vec![false; tris.len()];
         for (bounds, prims) in &leaves {
             assert!(prims.len() <= 8);
             for &i in prims {
@@ -571,13 +489,13 @@ fn the_cornell_boxs_walls_are_leaves_of_their_own_at_any_scale() {
             }
         }
         assert!(seen.iter().all(|&s| s));
-        for wall in 0..5u32 {
+        for wall in 0..5 {
             let (bounds, prims) = leaves
                 .iter()
-                .find(|(_, p)| p.contains(&(2 * wall)))
+                .find(|(_, p)| p.iter().any(|&i| shape_of[i as usize] == wall))
                 .expect("every triangle is in a leaf");
             assert_eq!(prims.len(), 2, "wall {wall} at scale {scale}: {prims:?}");
-            assert!(prims.contains(&(2 * wall + 1)));
+            assert!(prims.iter().all(|&i| shape_of[i as usize] == wall));
             // Flat but for the measured box's out-of-plane left wall (6.4 mm).
             let thickness = bounds.diagonal().min_element();
             assert!(thickness <= 6.5 * scale, "wall {wall}: {thickness}");
@@ -598,11 +516,11 @@ fn the_cornell_boxs_walls_are_leaves_of_their_own_at_any_scale() {
 fn the_cornell_box_built_bottom_up_equals_brute_force() {
     let mut rng = Pcg32::new(5, 3);
     for (offset, scale) in [(Vec3::ZERO, 1.0), (Vec3::new(-4e3, 1e3, 2e3), 0.01)] {
-        let tris = cornell_box(offset, scale);
+        let (tris, _) = cornell_box(offset, scale);
         let tbvh = TriangleBvh::from_soup(&tris);
         let mut hits = 0;
         for i in 0..20_000 {
-            let t = tris[(rng.next_u32() % 32) as usize];
+            let t = tris[rng.next_u32() as usize % tris.len()];
             let u = Vec2::new(rng.uniform(), rng.uniform());
             let b = radiant_math::sampling::uniform_triangle(u);
             let on = t[0] * b[0] + t[1] * b[1] + t[2] * b[2];
