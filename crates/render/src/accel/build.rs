@@ -31,7 +31,7 @@ pub(crate) struct BuildSettings {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PrimRef {
     pub min: Vec3,
-    id: u32,
+    pub id: u32,
     pub max: Vec3,
 }
 
@@ -75,8 +75,16 @@ pub(crate) const MAX_DEPTH: u32 = 60;
 /// Builds the binary tree over the boxes with finite, non-empty bounds (others can never
 /// be hit and are left out). Returns the root (`None` when nothing remains) and the leaf
 /// order: leaf ranges index into it, and it holds the original primitive indices.
+///
+/// `kinds` gives each primitive a kind (empty: all of one kind), and no leaf holds
+/// primitives of two kinds. The triangle BVH keeps emitters apart from the rest: shadow
+/// rays stop just short of the emitter they aim at, so an emitter's own flat leaf is not
+/// entered by them, while a leaf that also held nearby geometry would be entered, and
+/// tested, by nearly all of them (on the Cornell box, the light shared a leaf with the
+/// top of the tall block, and 90 % of the shadow rays tested it).
 pub(crate) fn build_binary(
     prim_bounds: &[Aabb],
+    kinds: &[u8],
     settings: &BuildSettings,
 ) -> (Option<BuildNode>, Vec<u32>) {
     let mut refs: Vec<PrimRef> = prim_bounds
@@ -95,6 +103,7 @@ pub(crate) fn build_binary(
     let costs = Costs {
         settings,
         rays: RayModel::inside(&range_bounds(&refs).0),
+        kinds,
     };
     let root = build_range(&mut refs, 0, 0, &costs);
     (Some(root), refs.iter().map(|r| r.id).collect())
@@ -288,6 +297,12 @@ fn split_range(
         start: offset,
         count: n as u32,
     };
+    if n <= s.max_leaf as usize && c.kind_of_all(refs).is_none() {
+        // Small enough for a leaf, but of two kinds: one subtree per kind.
+        let first = c.kind(&refs[0]);
+        let k = partition(refs, |r| c.kind(r) == first);
+        return split_inner(refs, offset, depth, c, bounds, k);
+    }
     let leaf_cost = n.div_ceil(s.leaf_block as usize) as f32;
     // Near the depth bound (or with all centroids coincident) fall back to halving
     // the range, which reaches single primitives within log2(n) more levels.
@@ -323,8 +338,21 @@ fn split_range(
             _ => n / 2,
         }
     };
-    let (left, right) = refs.split_at_mut(split_at);
-    let right_offset = offset + split_at as u32;
+    split_inner(refs, offset, depth, c, bounds, split_at)
+}
+
+/// The inner node over `refs` split after the first `k`, its halves built in turn.
+fn split_inner(
+    refs: &mut [PrimRef],
+    offset: u32,
+    depth: u32,
+    c: &Costs,
+    bounds: Aabb,
+    k: usize,
+) -> BuildNode {
+    let n = refs.len();
+    let (left, right) = refs.split_at_mut(k);
+    let right_offset = offset + k as u32;
     let (l, r) = if n >= PARALLEL_MIN {
         rayon::join(
             || build_range(left, offset, depth + 1, c),

@@ -65,7 +65,7 @@ impl Bvh {
     /// 8-wide node array. Primitives whose box is empty or not
     /// finite can never be hit and are left out.
     pub fn build(prim_bounds: &[Aabb]) -> Bvh {
-        let (root, order) = build_binary(prim_bounds, &SETTINGS);
+        let (root, order) = build_binary(prim_bounds, &[], &SETTINGS);
         let Some(root) = root else {
             return Bvh::default();
         };

@@ -87,9 +87,24 @@ fn volume(b: &Aabb) -> f32 {
 pub(crate) struct Costs<'a> {
     pub settings: &'a BuildSettings,
     pub rays: RayModel,
+    /// Each primitive's kind by its index (empty: all of one kind); no leaf mixes kinds
+    /// (see `build_binary`).
+    pub kinds: &'a [u8],
 }
 
 impl Costs<'_> {
+    /// The kind of a primitive.
+    #[inline]
+    pub fn kind(&self, r: &PrimRef) -> u8 {
+        self.kinds.get(r.id as usize).copied().unwrap_or(0)
+    }
+
+    /// The kind shared by all of `refs` (not empty), `None` when they mix kinds.
+    pub fn kind_of_all(&self, refs: &[PrimRef]) -> Option<u8> {
+        let first = self.kind(&refs[0]);
+        refs.iter().all(|r| self.kind(r) == first).then_some(first)
+    }
+
     /// The expected cost of a binary tree, unnormalised: the sum of its nodes' costs.
     pub fn tree_cost(&self, node: &BuildNode) -> f32 {
         match node {
@@ -118,10 +133,11 @@ struct Cluster {
     node: u32,
 }
 
-/// A merge-tree node: a primitive (an index into the range) or two earlier nodes.
+/// A merge-tree node: a primitive (an index into the range, and its kind) or two earlier
+/// nodes.
 #[derive(Clone, Copy)]
 enum Merge {
-    Prim(u32, Aabb),
+    Prim(u32, Aabb, u8),
     Pair(u32, u32, Aabb),
 }
 
@@ -136,8 +152,9 @@ pub(crate) fn cluster_range(refs: &mut [PrimRef], offset: u32, c: &Costs) -> (Bu
     });
     let mut tree: Vec<Merge> = boxes
         .clone()
+        .zip(refs.iter())
         .enumerate()
-        .map(|(i, b)| Merge::Prim(i as u32, b))
+        .map(|(i, (b, r))| Merge::Prim(i as u32, b, c.kind(r)))
         .collect();
     let mut live: Vec<Cluster> = boxes
         .enumerate()
@@ -199,7 +216,7 @@ pub(crate) fn cluster_range(refs: &mut [PrimRef], offset: u32, c: &Costs) -> (Bu
     let mut stack = vec![root];
     while let Some(t) = stack.pop() {
         match tree[t as usize] {
-            Merge::Prim(p, _) => order.push(p),
+            Merge::Prim(p, ..) => order.push(p),
             Merge::Pair(a, b, _) => {
                 stack.push(b);
                 stack.push(a);
@@ -211,16 +228,17 @@ pub(crate) fn cluster_range(refs: &mut [PrimRef], offset: u32, c: &Costs) -> (Bu
         *slot = original[p as usize];
     }
     let mut next = offset;
-    let (node, cost, _) = cut(&tree, root, &mut next, c);
+    let (node, cost, _, _) = cut(&tree, root, &mut next, c);
     (node, cost)
 }
 
-/// The subtree of merge node `t` with its leaves chosen by the ray model, and its cost
-/// (in block intersections, unnormalised: weight times expected work).
+/// The subtree of merge node `t` with its leaves chosen by the ray model, its cost (in
+/// block intersections, unnormalised: weight times expected work), its primitive count
+/// and the kind its primitives share (`None` when mixed: it is then never a leaf).
 /// Assigns ranges in the depth-first order `cluster_range` laid the primitives out in.
-fn cut(tree: &[Merge], t: u32, next: &mut u32, c: &Costs) -> (BuildNode, f32, u32) {
+fn cut(tree: &[Merge], t: u32, next: &mut u32, c: &Costs) -> (BuildNode, f32, u32, Option<u8>) {
     match tree[t as usize] {
-        Merge::Prim(_, bounds) => {
+        Merge::Prim(_, bounds, kind) => {
             let start = *next;
             *next += 1;
             let cost = c.leaf(&bounds, 1);
@@ -232,16 +250,18 @@ fn cut(tree: &[Merge], t: u32, next: &mut u32, c: &Costs) -> (BuildNode, f32, u3
                 },
                 cost,
                 1,
+                Some(kind),
             )
         }
         Merge::Pair(a, b, bounds) => {
             let start = *next;
-            let (l, lc, ln) = cut(tree, a, next, c);
-            let (r, rc, rn) = cut(tree, b, next, c);
+            let (l, lc, ln, lk) = cut(tree, a, next, c);
+            let (r, rc, rn, rk) = cut(tree, b, next, c);
             let count = ln + rn;
+            let kind = if lk == rk { lk } else { None };
             let split_cost = c.inner(&bounds) + lc + rc;
             let leaf_cost = c.leaf(&bounds, count);
-            if count <= c.settings.max_leaf && leaf_cost <= split_cost {
+            if count <= c.settings.max_leaf && leaf_cost <= split_cost && kind.is_some() {
                 (
                     BuildNode::Leaf {
                         bounds,
@@ -250,6 +270,7 @@ fn cut(tree: &[Merge], t: u32, next: &mut u32, c: &Costs) -> (BuildNode, f32, u3
                     },
                     leaf_cost,
                     count,
+                    kind,
                 )
             } else {
                 (
@@ -259,6 +280,7 @@ fn cut(tree: &[Merge], t: u32, next: &mut u32, c: &Costs) -> (BuildNode, f32, u3
                     },
                     split_cost,
                     count,
+                    kind,
                 )
             }
         }

@@ -73,6 +73,17 @@ impl TriangleBvh {
     /// Binned SAH build (Wald 2007), subtrees in parallel with rayon; leaves of up to 8
     /// triangles in 4-triangle SIMD blocks; 8-wide nodes.
     pub fn build(vertices: &[Vec3], triangles: &[[u32; 3]]) -> TriangleBvh {
+        TriangleBvh::build_with_emitters(vertices, triangles, &[])
+    }
+
+    /// [`build`](Self::build) where `emitting[i]` says whether triangle i emits light
+    /// (empty: none does): emitting triangles never share a leaf with others, which shadow
+    /// rays, ending just short of an emitter, would then enter (`build_binary`).
+    pub fn build_with_emitters(
+        vertices: &[Vec3],
+        triangles: &[[u32; 3]],
+        emitting: &[bool],
+    ) -> TriangleBvh {
         let corners = |t: &[u32; 3]| -> Option<[Vec3; 3]> {
             let p = [
                 *vertices.get(t[0] as usize)?,
@@ -85,7 +96,8 @@ impl TriangleBvh {
             .iter()
             .map(|t| corners(t).map_or(Aabb::EMPTY, |p| Aabb::from_points(&p)))
             .collect();
-        let (root, order) = build_binary(&bounds, &SETTINGS);
+        let kinds: Vec<u8> = emitting.iter().map(|&e| u8::from(e)).collect();
+        let (root, order) = build_binary(&bounds, &kinds, &SETTINGS);
         let Some(root) = root else {
             return TriangleBvh::default();
         };
@@ -164,11 +176,17 @@ impl TriangleBvh {
 
     /// Builds from a triangle soup (three corners per triangle).
     pub fn from_soup(triangles: &[[Vec3; 3]]) -> TriangleBvh {
+        TriangleBvh::from_soup_with_emitters(triangles, &[])
+    }
+
+    /// [`from_soup`](Self::from_soup) with the emitting triangles marked, as
+    /// [`build_with_emitters`](Self::build_with_emitters).
+    pub fn from_soup_with_emitters(triangles: &[[Vec3; 3]], emitting: &[bool]) -> TriangleBvh {
         let vertices: Vec<Vec3> = triangles.iter().flatten().copied().collect();
         let indices: Vec<[u32; 3]> = (0..triangles.len() as u32)
             .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
             .collect();
-        TriangleBvh::build(&vertices, &indices)
+        TriangleBvh::build_with_emitters(&vertices, &indices, emitting)
     }
 
     /// Closest hit with 0 < t < t_max (watertight, two-sided).

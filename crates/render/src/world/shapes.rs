@@ -126,7 +126,12 @@ impl ShapeSet {
 
     /// Builds both BVHs; prototypes must be finished before the sets that instance them.
     pub(crate) fn finish(&mut self, prototypes: &[ShapeSet]) {
-        self.triangle_bvh = TriangleBvh::from_soup(&self.triangles);
+        let emitting: Vec<bool> = self
+            .triangle_attrs
+            .iter()
+            .map(|a| a.light != NO_LIGHT)
+            .collect();
+        self.triangle_bvh = TriangleBvh::from_soup_with_emitters(&self.triangles, &emitting);
         self.bvh = Bvh::build(&self.prim_bounds(prototypes));
     }
 
