@@ -77,7 +77,7 @@ pub(crate) const MAX_DEPTH: u32 = 60;
 /// order: leaf ranges index into it, and it holds the original primitive indices.
 ///
 /// `kinds` gives each primitive a kind (empty: all of one kind), and no leaf holds
-/// primitives of two kinds. The triangle BVH keeps emitters apart from the rest: shadow
+/// primitives of two kinds (short of the depth bound). The triangle BVH keeps emitters apart from the rest: shadow
 /// rays stop just short of the emitter they aim at, so an emitter's own flat leaf is not
 /// entered by them, while a leaf that also held nearby geometry would be entered, and
 /// tested, by nearly all of them (on the Cornell box, the light shared a leaf with the
@@ -297,8 +297,14 @@ fn split_range(
         start: offset,
         count: n as u32,
     };
-    if n <= s.max_leaf as usize && c.kind_of_all(refs).is_none() {
-        // Small enough for a leaf, but of two kinds: one subtree per kind.
+    // Small enough for a leaf, but of two kinds: one subtree per kind. The extra level
+    // is not taken near the depth bound, whose fallback below must still reach single
+    // primitives within it (a mixed leaf there costs speed, never a hit).
+    let levels_left = usize::BITS - n.leading_zeros();
+    if n <= s.max_leaf as usize
+        && depth + levels_left + 2 < MAX_DEPTH
+        && c.kind_of_all(refs).is_none()
+    {
         let first = c.kind(&refs[0]);
         let k = partition(refs, |r| c.kind(r) == first);
         return split_inner(refs, offset, depth, c, bounds, k);
