@@ -23,6 +23,13 @@ pub(crate) struct BuildSettings {
     pub leaf_block: u32,
     /// Largest leaf the SAH may choose.
     pub max_leaf: u32,
+    /// Primitives the leaf kernel tests at once (two blocks of triangles in one 8-lane
+    /// test): the unit of a leaf's cost in the bottom-up build (cluster.rs).
+    pub leaf_test: u32,
+    /// Largest leaf the bottom-up build may choose. Its ranges are small and span much
+    /// of the scene, and there a whole object (a box of 10–12 triangles) in one leaf
+    /// tested in two kernel calls is cheaper than a node over its faces.
+    pub max_cluster_leaf: u32,
     /// Cost of one node visit relative to one block intersection.
     pub cost_traversal: f32,
 }

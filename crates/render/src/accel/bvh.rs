@@ -57,6 +57,8 @@ pub struct Bvh {
 const SETTINGS: BuildSettings = BuildSettings {
     leaf_block: 1,
     max_leaf: 4,
+    leaf_test: 1,
+    max_cluster_leaf: 4,
     cost_traversal: 1.0,
 };
 

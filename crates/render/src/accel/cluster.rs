@@ -17,6 +17,7 @@
 //! [`RayModel`] also counts the rays that start inside a box.
 
 use super::build::{BuildNode, BuildSettings, PrimRef};
+use super::node::WIDTH;
 use crate::geometry::Aabb;
 use glam::Vec3;
 
@@ -115,22 +116,60 @@ impl Costs<'_> {
         }
     }
 
-    /// A leaf's cost: its weight times its block tests.
+    /// A leaf's cost: its weight times the leaf kernel's tests (a block of four triangles
+    /// and a pair of blocks both take one 8-lane test).
     fn leaf(&self, bounds: &Aabb, count: u32) -> f32 {
-        self.rays.weight(bounds) * count.div_ceil(self.settings.leaf_block) as f32
+        self.rays.weight(bounds) * count.div_ceil(self.settings.leaf_test) as f32
     }
 
-    /// An inner node's own cost: its weight times the cost of a visit.
+    /// An inner node's own cost: its weight times its share of a wide node's visit. The
+    /// binary tree is collapsed into nodes of `WIDTH` children, each of which absorbs up
+    /// to `WIDTH − 1` binary nodes, so a binary node charged a whole visit would make
+    /// splits look costlier than they are: in a room, every grouping of two walls spans
+    /// the room, and the cut then kept the walls together in one room-spanning leaf
+    /// (entered by every ray) rather than as flat leaves of one wide node.
     fn inner(&self, bounds: &Aabb) -> f32 {
-        self.settings.cost_traversal * self.rays.weight(bounds)
+        self.settings.cost_traversal * self.rays.weight(bounds) / (WIDTH - 1) as f32
     }
 }
 
-/// A cluster during the merge: its box and its node in the merge tree.
+/// A cluster during the merge: its box, its node in the merge tree and the kind its
+/// primitives share (`None` when they mix kinds).
 #[derive(Clone, Copy)]
 struct Cluster {
     bounds: Aabb,
     node: u32,
+    kind: Option<u8>,
+}
+
+/// What merging two clusters costs: first whether it mixes kinds, then the weight of the
+/// union. Clusters of one kind are merged before any two of different kinds, so that each
+/// kind forms subtrees of its own, united only near the top. Shadow rays end on the
+/// emitters; a box that unites an emitter with other geometry spans the space in front of
+/// the emitter, which nearly every shadow ray crosses, while the emitter's own flat box is
+/// entered by none of them.
+#[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
+struct MergeCost {
+    mixes_kinds: bool,
+    weight: f32,
+}
+
+impl MergeCost {
+    const NONE: MergeCost = MergeCost {
+        mixes_kinds: true,
+        weight: f32::INFINITY,
+    };
+
+    fn of(a: &Cluster, b: &Cluster, c: &Costs) -> MergeCost {
+        MergeCost {
+            mixes_kinds: a.kind.is_none() || a.kind != b.kind,
+            weight: c.rays.weight(&a.bounds.union(&b.bounds)),
+        }
+    }
+
+    fn less(&self, other: &MergeCost) -> bool {
+        (self.mixes_kinds, self.weight) < (other.mixes_kinds, other.weight)
+    }
 }
 
 /// A merge-tree node: a primitive (an index into the range, and its kind) or two earlier
@@ -157,39 +196,51 @@ pub(crate) fn cluster_range(refs: &mut [PrimRef], offset: u32, c: &Costs) -> (Bu
         .map(|(i, (b, r))| Merge::Prim(i as u32, b, c.kind(r)))
         .collect();
     let mut live: Vec<Cluster> = boxes
+        .zip(refs.iter())
         .enumerate()
-        .map(|(i, bounds)| Cluster {
+        .map(|(i, (bounds, r))| Cluster {
             bounds,
             node: i as u32,
+            kind: Some(c.kind(r)),
         })
         .collect();
-    // Each cluster's cheapest partner (index into `live`) and the union's weight.
-    let nearest = |live: &[Cluster], i: usize| -> (usize, f32) {
-        let mut best = (usize::MAX, f32::INFINITY);
+    // Each cluster's cheapest partner (index into `live`) and what merging them costs.
+    let nearest = |live: &[Cluster], i: usize| -> (usize, MergeCost) {
+        let mut best = (usize::MAX, MergeCost::NONE);
         for (j, other) in live.iter().enumerate() {
             if j != i {
-                let a = c.rays.weight(&live[i].bounds.union(&other.bounds));
-                if a < best.1 {
-                    best = (j, a);
+                let m = MergeCost::of(&live[i], other, c);
+                if m.less(&best.1) {
+                    best = (j, m);
                 }
             }
         }
         best
     };
-    let mut partner: Vec<(usize, f32)> = (0..live.len()).map(|i| nearest(&live, i)).collect();
+    let mut partner: Vec<(usize, MergeCost)> = (0..live.len()).map(|i| nearest(&live, i)).collect();
     while live.len() > 1 {
         // The globally cheapest pair; ties go to the lowest index, so the tree is a pure
         // function of the input order.
         let (i, &(j, _)) = partner
             .iter()
             .enumerate()
-            .min_by(|a, b| a.1.1.total_cmp(&b.1.1).then(a.0.cmp(&b.0)))
+            .min_by(|a, b| {
+                let (x, y) = (a.1.1, b.1.1);
+                (x.mixes_kinds.cmp(&y.mixes_kinds))
+                    .then(x.weight.total_cmp(&y.weight))
+                    .then(a.0.cmp(&b.0))
+            })
             .expect("at least two clusters");
         let bounds = live[i].bounds.union(&live[j].bounds);
         tree.push(Merge::Pair(live[i].node, live[j].node, bounds));
         let merged = Cluster {
             bounds,
             node: (tree.len() - 1) as u32,
+            kind: if live[i].kind == live[j].kind {
+                live[i].kind
+            } else {
+                None
+            },
         };
         let (lo, hi) = (i.min(j), i.max(j));
         live[lo] = merged;
@@ -203,9 +254,9 @@ pub(crate) fn cluster_range(refs: &mut [PrimRef], offset: u32, c: &Costs) -> (Bu
             if k == lo || p == lo || p == hi || p == moved_from {
                 partner[k] = nearest(&live, k);
             } else {
-                let a = c.rays.weight(&live[k].bounds.union(&bounds));
-                if a < partner[k].1 {
-                    partner[k] = (lo, a);
+                let m = MergeCost::of(&live[k], &merged, c);
+                if m.less(&partner[k].1) {
+                    partner[k] = (lo, m);
                 }
             }
         }
@@ -261,7 +312,7 @@ fn cut(tree: &[Merge], t: u32, next: &mut u32, c: &Costs) -> (BuildNode, f32, u3
             let kind = if lk == rk { lk } else { None };
             let split_cost = c.inner(&bounds) + lc + rc;
             let leaf_cost = c.leaf(&bounds, count);
-            if count <= c.settings.max_leaf && leaf_cost <= split_cost && kind.is_some() {
+            if count <= c.settings.max_cluster_leaf && leaf_cost <= split_cost && kind.is_some() {
                 (
                     BuildNode::Leaf {
                         bounds,

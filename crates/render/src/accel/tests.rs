@@ -474,6 +474,8 @@ fn the_cornell_boxs_walls_are_leaves_of_their_own_at_any_scale() {
     let settings = super::build::BuildSettings {
         leaf_block: 4,
         max_leaf: 8,
+        leaf_test: 8,
+        max_cluster_leaf: 16,
         cost_traversal: 1.0,
     };
     let mut first: Option<Vec<Vec<u32>>> = None;
@@ -544,6 +546,8 @@ fn emitting_triangles_are_in_leaves_of_their_own() {
     let settings = super::build::BuildSettings {
         leaf_block: 4,
         max_leaf: 8,
+        leaf_test: 8,
+        max_cluster_leaf: 16,
         cost_traversal: 1.0,
     };
     let emitting = cornell_box_emitting();
@@ -670,5 +674,192 @@ fn the_interior_ray_model_weighs_boxes_by_area_and_by_volume_in_chords() {
             (got / expect - 1.0).abs() < 1e-3,
             "{got} against {expect} at scale {k}"
         );
+    }
+}
+
+/// The triangles of an axis-aligned box's six faces.
+fn box_triangles(lo: Vec3, hi: Vec3) -> Vec<[Vec3; 3]> {
+    let c = |i: usize| {
+        Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    let faces = [
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+    ];
+    faces
+        .iter()
+        .flat_map(|f| [[c(f[0]), c(f[1]), c(f[2])], [c(f[0]), c(f[2]), c(f[3])]])
+        .collect()
+}
+
+/// A room of five separate walls (a floor, a ceiling and three walls, two triangles each),
+/// a light just under the ceiling and two closed boxes of twelve triangles: more triangles
+/// than one bottom-up range takes, so the top-down build splits first. Every wall is
+/// still a flat leaf of its own: a leaf grouping walls spans the room and is entered by
+/// every ray (the binary cost of the nodes that separate walls once hid that a wide node
+/// absorbs them). The light's triangles are a leaf of their own as well.
+#[test]
+fn separate_walls_of_a_room_are_flat_leaves_at_any_scale() {
+    let settings = super::build::BuildSettings {
+        leaf_block: 4,
+        max_leaf: 8,
+        leaf_test: 8,
+        max_cluster_leaf: 16,
+        cost_traversal: 1.0,
+    };
+    for (offset, scale) in [
+        (Vec3::ZERO, 1.0),
+        (Vec3::new(-3e-3, 2e-3, 7e-3), 1e-5),
+        (Vec3::new(4e6, -9e6, 2e6), 1e4),
+    ] {
+        let p = |x: f32, y: f32, z: f32| offset + scale * Vec3::new(x, y, z);
+        let quad = |a: Vec3, b: Vec3, c: Vec3, d: Vec3| [[a, b, c], [a, c, d]];
+        let mut tris: Vec<[Vec3; 3]> = Vec::new();
+        let mut group: Vec<usize> = Vec::new();
+        let walls = [
+            quad(
+                p(-1., 0., -1.),
+                p(1., 0., -1.),
+                p(1., 0., 1.),
+                p(-1., 0., 1.),
+            ),
+            quad(
+                p(-1., 2., -1.),
+                p(-1., 2., 1.),
+                p(1., 2., 1.),
+                p(1., 2., -1.),
+            ),
+            quad(
+                p(-1., 0., -1.),
+                p(-1., 2., -1.),
+                p(1., 2., -1.),
+                p(1., 0., -1.),
+            ),
+            quad(
+                p(-1., 0., -1.),
+                p(-1., 0., 1.),
+                p(-1., 2., 1.),
+                p(-1., 2., -1.),
+            ),
+            quad(p(1., 0., -1.), p(1., 2., -1.), p(1., 2., 1.), p(1., 0., 1.)),
+            quad(
+                p(-0.2, 1.98, -0.2),
+                p(0.2, 1.98, -0.2),
+                p(0.2, 1.98, 0.2),
+                p(-0.2, 1.98, 0.2),
+            ),
+        ];
+        for (g, w) in walls.iter().enumerate() {
+            tris.extend(w);
+            group.extend([g, g]);
+        }
+        for (g, (lo, hi)) in [
+            (p(-0.7, 0., -0.7), p(0.05, 1.2, 0.1)),
+            (p(0.0, 0., 0.2), p(0.7, 0.6, 0.75)),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let b = box_triangles(lo, hi);
+            group.extend(std::iter::repeat_n(6 + g, b.len()));
+            tris.extend(b);
+        }
+        let kinds: Vec<u8> = group.iter().map(|&g| u8::from(g == 5)).collect();
+        let (root, order) = super::build::build_binary(&tri_bounds(&tris), &kinds, &settings);
+        let mut leaves = Vec::new();
+        build_leaves(&root.expect("a tree"), &order, &mut leaves);
+        for wall in 0..6 {
+            let (bounds, prims) = leaves
+                .iter()
+                .find(|(_, p)| p.iter().any(|&i| group[i as usize] == wall))
+                .expect("every triangle is in a leaf");
+            assert!(
+                prims.iter().all(|&i| group[i as usize] == wall),
+                "wall {wall} at scale {scale} shares a leaf: {:?}",
+                prims.iter().map(|&i| group[i as usize]).collect::<Vec<_>>()
+            );
+            assert_eq!(
+                bounds.diagonal().min_element(),
+                0.0,
+                "wall {wall} at scale {scale}"
+            );
+        }
+    }
+}
+
+/// The bottom-up build merges clusters of one kind before any two of different kinds,
+/// so each kind's primitives form one subtree of their own (random soups, random kinds).
+#[test]
+fn clusters_of_one_kind_merge_first() {
+    use super::build::{BuildNode, BuildSettings, PrimRef};
+    use super::cluster::{Costs, RayModel, cluster_range};
+    let settings = BuildSettings {
+        leaf_block: 4,
+        max_leaf: 8,
+        leaf_test: 8,
+        max_cluster_leaf: 16,
+        cost_traversal: 1.0,
+    };
+    /// The kinds under `node` (a bit each), and the number of maximal one-kind subtrees
+    /// found under it, per kind.
+    fn kinds_under(node: &BuildNode, order: &[u32], kinds: &[u8], pure: &mut [u32; 2]) -> u8 {
+        match node {
+            BuildNode::Leaf { start, count, .. } => order
+                [*start as usize..(*start + *count) as usize]
+                .iter()
+                .fold(0, |m, &i| m | 1 << kinds[i as usize]),
+            BuildNode::Inner { children, .. } => {
+                let l = kinds_under(&children[0], order, kinds, pure);
+                let r = kinds_under(&children[1], order, kinds, pure);
+                if l | r == 3 {
+                    // A mixed node: its one-kind children are maximal.
+                    for m in [l, r] {
+                        if m != 3 {
+                            pure[m as usize >> 1] += 1;
+                        }
+                    }
+                }
+                l | r
+            }
+        }
+    }
+    let mut rng = Pcg32::new(31, 7);
+    for n in [2, 5, 9, 17, 32] {
+        for _ in 0..20 {
+            let tris = soup(&mut rng, n);
+            let kinds: Vec<u8> = (0..n).map(|_| u8::from(rng.uniform() < 0.3)).collect();
+            let mut refs: Vec<PrimRef> = tri_bounds(&tris)
+                .iter()
+                .enumerate()
+                .map(|(i, b)| PrimRef {
+                    min: b.min,
+                    id: i as u32,
+                    max: b.max,
+                })
+                .collect();
+            let scene = tri_bounds(&tris)
+                .iter()
+                .fold(Aabb::EMPTY, |a, b| a.union(b));
+            let costs = Costs {
+                settings: &settings,
+                rays: RayModel::inside(&scene),
+                kinds: &kinds,
+            };
+            let (root, _) = cluster_range(&mut refs, 0, &costs);
+            let order: Vec<u32> = refs.iter().map(|r| r.id).collect();
+            let mut pure = [0u32; 2];
+            let all = kinds_under(&root, &order, &kinds, &mut pure);
+            if all == 3 {
+                assert_eq!(pure, [1, 1], "n {n}: each kind in one subtree");
+            }
+        }
     }
 }

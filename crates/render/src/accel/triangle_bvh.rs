@@ -45,10 +45,14 @@ pub struct TriangleBvh {
 
 /// SAH costs in units of one 4-triangle block test, a binary build node charged the same;
 /// up to 8 triangles (two blocks) per leaf. On the benchmark scene, cheaper nodes (0.3,
-/// 0.5) or single-block leaves made deeper trees and slower traversal.
+/// 0.5) or single-block leaves made deeper trees and slower traversal. The bottom-up
+/// build of small room-spanning ranges counts 8-triangle kernel tests and allows leaves
+/// of up to 16 (cluster.rs).
 const SETTINGS: BuildSettings = BuildSettings {
     leaf_block: 4,
     max_leaf: 8,
+    leaf_test: 8,
+    max_cluster_leaf: 16,
     cost_traversal: 1.0,
 };
 
