@@ -112,8 +112,59 @@ pub(crate) fn build_binary(
         rays: RayModel::inside(&range_bounds(&refs).0),
         kinds,
     };
-    let root = build_range(&mut refs, 0, 0, &costs);
+    let mut root = build_range(&mut refs, 0, 0, &costs);
+    merge_small_wide_nodes(&mut root, &refs, &costs);
     (Some(root), refs.iter().map(|r| r.id).collect())
+}
+
+/// Makes one leaf of each subtree that the collapse would make a wide node of its own
+/// where the leaf is cheaper than that node's visit and its children. The build prices
+/// a binary node at its share of a wide node (cluster.rs), which holds where the node is
+/// absorbed into its parent's wide node; where the parent's slots are full, the subtree
+/// becomes a wide node of its own after all, and its visit costs in full. On the Cornell
+/// box, whose walls and light fill a wide node's slots, each block is cheaper as one
+/// leaf of 10 triangles (two kernel tests) than as a node over its faces. `node` is the
+/// root of a wide node; returns its cost after the merges.
+fn merge_small_wide_nodes(node: &mut BuildNode, refs: &[PrimRef], c: &Costs) -> f32 {
+    let mut cost = c.settings.cost_traversal * c.rays.weight(node.bounds());
+    for slot in wide_children_mut(node) {
+        cost += match slot {
+            BuildNode::Leaf { bounds, count, .. } => c.leaf(bounds, *count),
+            BuildNode::Inner { .. } => {
+                let as_node = merge_small_wide_nodes(slot, refs, c);
+                let (start, count) = leaf_range(slot);
+                let bounds = *slot.bounds();
+                let prims = &refs[start as usize..(start + count) as usize];
+                let as_leaf = c.leaf(&bounds, count);
+                if count <= c.settings.max_cluster_leaf
+                    && c.kind_of_all(prims).is_some()
+                    && as_leaf < as_node
+                {
+                    *slot = BuildNode::Leaf {
+                        bounds,
+                        start,
+                        count,
+                    };
+                    as_leaf
+                } else {
+                    as_node
+                }
+            }
+        };
+    }
+    cost
+}
+
+/// The contiguous range of the leaf order that a subtree covers: (start, count).
+fn leaf_range(node: &BuildNode) -> (u32, u32) {
+    match node {
+        BuildNode::Leaf { start, count, .. } => (*start, *count),
+        BuildNode::Inner { children, .. } => {
+            let (start, left) = leaf_range(&children[0]);
+            let (_, right) = leaf_range(&children[1]);
+            (start, left + right)
+        }
+    }
 }
 
 /// Bounds of the boxes and of their (doubled) centroids.
@@ -431,6 +482,35 @@ fn wide_children(node: &BuildNode) -> Vec<&BuildNode> {
             unreachable!("only inner nodes are opened")
         };
         slots.extend(children.iter());
+    }
+    slots
+}
+
+/// [`wide_children`], mutable: the same slots, in the same order.
+fn wide_children_mut(node: &mut BuildNode) -> Vec<&mut BuildNode> {
+    let BuildNode::Inner { children, .. } = node else {
+        return vec![node];
+    };
+    let [a, b] = &mut **children;
+    let mut slots: Vec<&mut BuildNode> = vec![a, b];
+    while slots.len() < WIDTH {
+        let widest = slots
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| matches!(c, BuildNode::Inner { .. }))
+            .max_by(|a, b| {
+                a.1.bounds()
+                    .surface_area()
+                    .total_cmp(&b.1.bounds().surface_area())
+            })
+            .map(|(i, _)| i);
+        let Some(i) = widest else { break };
+        let BuildNode::Inner { children, .. } = slots.swap_remove(i) else {
+            unreachable!("only inner nodes are opened")
+        };
+        let [a, b] = &mut **children;
+        slots.push(a);
+        slots.push(b);
     }
     slots
 }

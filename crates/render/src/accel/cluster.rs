@@ -118,7 +118,7 @@ impl Costs<'_> {
 
     /// A leaf's cost: its weight times the leaf kernel's tests (a block of four triangles
     /// and a pair of blocks both take one 8-lane test).
-    fn leaf(&self, bounds: &Aabb, count: u32) -> f32 {
+    pub fn leaf(&self, bounds: &Aabb, count: u32) -> f32 {
         self.rays.weight(bounds) * count.div_ceil(self.settings.leaf_test) as f32
     }
 
@@ -142,33 +142,51 @@ struct Cluster {
     kind: Option<u8>,
 }
 
-/// What merging two clusters costs: first whether it mixes kinds, then the weight of the
-/// union. Clusters of one kind are merged before any two of different kinds, so that each
-/// kind forms subtrees of its own, united only near the top. Shadow rays end on the
-/// emitters; a box that unites an emitter with other geometry spans the space in front of
-/// the emitter, which nearly every shadow ray crosses, while the emitter's own flat box is
+/// What merging two clusters costs, compared in this order: whether it mixes kinds, how
+/// much the union outweighs the heavier of the two, and the union's weight.
+///
+/// Clusters of one kind are merged before any two of different kinds, so that each kind
+/// forms subtrees of its own, united only near the top. Shadow rays end on the emitters;
+/// a box that unites an emitter with other geometry spans the space in front of the
+/// emitter, which nearly every shadow ray crosses, while the emitter's own flat box is
 /// entered by none of them.
-#[derive(Clone, Copy, Debug, PartialEq, PartialOrd)]
+///
+/// The growth comes before the union's weight so that what lies within a cluster's box
+/// joins it first: the faces of a block join the block before a face of the block next
+/// to it, whose union with them would span both. Merging by the union's weight alone
+/// (Walter et al.) joined the last faces of the Cornell box's two blocks to each other.
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct MergeCost {
     mixes_kinds: bool,
+    growth: f32,
     weight: f32,
 }
 
 impl MergeCost {
     const NONE: MergeCost = MergeCost {
         mixes_kinds: true,
+        growth: f32::INFINITY,
         weight: f32::INFINITY,
     };
 
     fn of(a: &Cluster, b: &Cluster, c: &Costs) -> MergeCost {
+        let weight = c.rays.weight(&a.bounds.union(&b.bounds));
+        let heavier = c.rays.weight(&a.bounds).max(c.rays.weight(&b.bounds));
         MergeCost {
             mixes_kinds: a.kind.is_none() || a.kind != b.kind,
-            weight: c.rays.weight(&a.bounds.union(&b.bounds)),
+            growth: (weight - heavier).max(0.0),
+            weight,
         }
     }
 
+    fn cmp(&self, other: &MergeCost) -> std::cmp::Ordering {
+        (self.mixes_kinds.cmp(&other.mixes_kinds))
+            .then(self.growth.total_cmp(&other.growth))
+            .then(self.weight.total_cmp(&other.weight))
+    }
+
     fn less(&self, other: &MergeCost) -> bool {
-        (self.mixes_kinds, self.weight) < (other.mixes_kinds, other.weight)
+        self.cmp(other).is_lt()
     }
 }
 
@@ -224,12 +242,7 @@ pub(crate) fn cluster_range(refs: &mut [PrimRef], offset: u32, c: &Costs) -> (Bu
         let (i, &(j, _)) = partner
             .iter()
             .enumerate()
-            .min_by(|a, b| {
-                let (x, y) = (a.1.1, b.1.1);
-                (x.mixes_kinds.cmp(&y.mixes_kinds))
-                    .then(x.weight.total_cmp(&y.weight))
-                    .then(a.0.cmp(&b.0))
-            })
+            .min_by(|a, b| a.1.1.cmp(&b.1.1).then(a.0.cmp(&b.0)))
             .expect("at least two clusters");
         let bounds = live[i].bounds.union(&live[j].bounds);
         tree.push(Merge::Pair(live[i].node, live[j].node, bounds));

@@ -478,6 +478,12 @@ fn the_cornell_boxs_walls_are_leaves_of_their_own_at_any_scale() {
         max_cluster_leaf: 16,
         cost_traversal: 1.0,
     };
+    // The light marked, as the renderer builds it (unmarked, it would share a flat leaf
+    // with the ceiling 0.1 mm above it).
+    let kinds: Vec<u8> = cornell_box_emitting()
+        .iter()
+        .map(|&e| u8::from(e))
+        .collect();
     let mut first: Option<Vec<Vec<u32>>> = None;
     for (offset, scale) in [
         (Vec3::ZERO, 1.0),
@@ -485,12 +491,12 @@ fn the_cornell_boxs_walls_are_leaves_of_their_own_at_any_scale() {
         (Vec3::new(4e6, -9e6, 2e6), 1e4),
     ] {
         let (tris, shape_of) = cornell_box(offset, scale);
-        let (root, order) = super::build::build_binary(&tri_bounds(&tris), &[], &settings);
+        let (root, order) = super::build::build_binary(&tri_bounds(&tris), &kinds, &settings);
         let mut leaves = Vec::new();
         build_leaves(&root.expect("a tree"), &order, &mut leaves);
         let mut seen = vec![false; tris.len()];
         for (bounds, prims) in &leaves {
-            assert!(prims.len() <= 8);
+            assert!(prims.len() <= settings.max_cluster_leaf as usize);
             for &i in prims {
                 assert!(!std::mem::replace(&mut seen[i as usize], true));
                 let b = Aabb::from_points(&tris[i as usize]);
@@ -573,7 +579,7 @@ fn emitting_triangles_are_in_leaves_of_their_own() {
         build_leaves(&root.expect("a tree"), &order, &mut leaves);
         let mut seen = vec![false; tris.len()];
         for (_, prims) in &leaves {
-            assert!(prims.len() <= 8);
+            assert!(prims.len() <= settings.max_cluster_leaf as usize);
             let kind = kinds[prims[0] as usize];
             assert!(
                 prims.iter().all(|&i| kinds[i as usize] == kind),
@@ -860,6 +866,42 @@ fn clusters_of_one_kind_merge_first() {
             if all == 3 {
                 assert_eq!(pure, [1, 1], "n {n}: each kind in one subtree");
             }
+        }
+    }
+}
+
+/// The canonical Cornell box's five walls, light and two blocks fill the eight slots of
+/// one wide node: each block is one leaf (a node over its faces would cost a second
+/// node visit to every ray that enters the block's box), each wall and the light a leaf
+/// of its own. At three scales and offsets.
+#[test]
+fn the_cornell_box_is_one_wide_node_of_whole_shapes_at_any_scale() {
+    let settings = super::build::BuildSettings {
+        leaf_block: 4,
+        max_leaf: 8,
+        leaf_test: 8,
+        max_cluster_leaf: 16,
+        cost_traversal: 1.0,
+    };
+    let emitting = cornell_box_emitting();
+    let kinds: Vec<u8> = emitting.iter().map(|&e| u8::from(e)).collect();
+    for (offset, scale) in [
+        (Vec3::ZERO, 1.0),
+        (Vec3::new(-3e-3, 2e-3, 7e-3), 1e-5),
+        (Vec3::new(4e6, -9e6, 2e6), 1e4),
+    ] {
+        let (tris, shape_of) = cornell_box(offset, scale);
+        let bvh = TriangleBvh::from_soup_with_emitters(&tris, &emitting);
+        assert_eq!(bvh.size().0, 1, "wide nodes at scale {scale}");
+        let (root, order) = super::build::build_binary(&tri_bounds(&tris), &kinds, &settings);
+        let mut leaves = Vec::new();
+        build_leaves(&root.expect("a tree"), &order, &mut leaves);
+        let shapes = shape_of.iter().max().unwrap() + 1;
+        assert_eq!(leaves.len(), shapes, "scale {scale}");
+        for (_, prims) in &leaves {
+            let shape = shape_of[prims[0] as usize];
+            let whole = shape_of.iter().filter(|&&s| s == shape).count();
+            assert_eq!(prims.len(), whole, "shape {shape} at scale {scale}");
         }
     }
 }
