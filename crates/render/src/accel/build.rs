@@ -467,23 +467,29 @@ fn wide_children(node: &BuildNode) -> Vec<&BuildNode> {
     };
     let mut slots: Vec<&BuildNode> = children.iter().collect();
     while slots.len() < WIDTH {
-        let widest = slots
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| matches!(c, BuildNode::Inner { .. }))
-            .max_by(|a, b| {
-                a.1.bounds()
-                    .surface_area()
-                    .total_cmp(&b.1.bounds().surface_area())
-            })
-            .map(|(i, _)| i);
-        let Some(i) = widest else { break };
+        let Some(i) = widest_inner(slots.iter().copied()) else {
+            break;
+        };
         let BuildNode::Inner { children, .. } = slots.swap_remove(i) else {
             unreachable!("only inner nodes are opened")
         };
         slots.extend(children.iter());
     }
     slots
+}
+
+/// The inner node with the largest surface area among `slots` (the last on a tie), which
+/// the collapse opens next.
+fn widest_inner<'a>(slots: impl Iterator<Item = &'a BuildNode>) -> Option<usize> {
+    slots
+        .enumerate()
+        .filter(|(_, c)| matches!(c, BuildNode::Inner { .. }))
+        .max_by(|a, b| {
+            a.1.bounds()
+                .surface_area()
+                .total_cmp(&b.1.bounds().surface_area())
+        })
+        .map(|(i, _)| i)
 }
 
 /// [`wide_children`], mutable: the same slots, in the same order.
@@ -494,17 +500,9 @@ fn wide_children_mut(node: &mut BuildNode) -> Vec<&mut BuildNode> {
     let [a, b] = &mut **children;
     let mut slots: Vec<&mut BuildNode> = vec![a, b];
     while slots.len() < WIDTH {
-        let widest = slots
-            .iter()
-            .enumerate()
-            .filter(|(_, c)| matches!(c, BuildNode::Inner { .. }))
-            .max_by(|a, b| {
-                a.1.bounds()
-                    .surface_area()
-                    .total_cmp(&b.1.bounds().surface_area())
-            })
-            .map(|(i, _)| i);
-        let Some(i) = widest else { break };
+        let Some(i) = widest_inner(slots.iter().map(|s| &**s)) else {
+            break;
+        };
         let BuildNode::Inner { children, .. } = slots.swap_remove(i) else {
             unreachable!("only inner nodes are opened")
         };
