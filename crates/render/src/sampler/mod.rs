@@ -25,7 +25,9 @@ use radiant_scene::SamplerKind;
 
 pub use halton::{PRIME_COUNT, PRIMES, randomized_radical_inverse};
 pub use sobol::{owen_scramble, scrambled_sobol, sobol_u32};
-use sobol::{owen_scramble_reversed, scrambled_further_sobol};
+use sobol::{
+    owen_scramble_reversed, scrambled_further_sobol_pair, scrambled_sobol_0, scrambled_sobol_pair,
+};
 pub use stratified::{permute, stratified_1d, stratified_2d};
 
 /// The sampler state for one pixel sample.
@@ -95,23 +97,24 @@ impl PixelSample {
     /// Burley's sample-index shuffle: the index is Owen-scrambled as if it were a binary
     /// fraction, so each bit flips depending only on the bits above it. The first 2^k
     /// indices then map to one aligned block of 2^k Sobol points, still a (0,2)-net, but
-    /// a different block and order for each dimension pair.
+    /// a different block and order for each dimension pair. Returned bit-reversed, as
+    /// the scramble leaves it; the Sobol tables read it so.
     #[inline(always)]
-    fn shuffled_index(&self, key: u64) -> u32 {
+    fn shuffled_index_reversed(&self, key: u64) -> u32 {
         owen_scramble_reversed(self.index_reversed, (key >> 16) as u32)
     }
 
     /// The Sobol value of dimension key `key` (dimension 0 of the shuffled index).
     #[inline(always)]
     fn sobol_1d(&self, key: u64) -> f32 {
-        let i = self.shuffled_index(key);
-        u32_to_unit_f32(scrambled_sobol(0, i, (key >> 32) as u32))
+        let r = self.shuffled_index_reversed(key);
+        u32_to_unit_f32(scrambled_sobol_0(r, (key >> 32) as u32))
     }
 
     /// The Sobol pair of dimension key `key`: dimensions 0 and 1 of the shuffled index.
     #[inline(always)]
     fn sobol_2d(&self, key: u64) -> Vec2 {
-        sobol_2d_at(self.shuffled_index(key), key)
+        sobol_2d_at(self.shuffled_index_reversed(key), key)
     }
 
     #[inline(always)]
@@ -128,11 +131,21 @@ impl PixelSample {
     #[inline(always)]
     pub fn get_2d_as_anchor(&mut self) -> (Vec2, SobolAnchor) {
         if self.kind != SamplerKind::Sobol {
-            return (self.get_2d(), SobolAnchor { shuffled_index: 0 });
+            return (
+                self.get_2d(),
+                SobolAnchor {
+                    shuffled_index_reversed: 0,
+                },
+            );
         }
         let key = self.next_key();
-        let i = self.shuffled_index(key);
-        (sobol_2d_at(i, key), SobolAnchor { shuffled_index: i })
+        let r = self.shuffled_index_reversed(key);
+        (
+            sobol_2d_at(r, key),
+            SobolAnchor {
+                shuffled_index_reversed: r,
+            },
+        )
     }
 
     /// A 2D draw that takes further dimensions of the Sobol point an earlier 2D draw,
@@ -147,16 +160,17 @@ impl PixelSample {
         if self.kind != SamplerKind::Sobol {
             return self.get_2d();
         }
-        let i = anchor.shuffled_index;
         let h = mix64(self.next_key());
-        let [dx, dy] = match pair {
+        let further = match pair {
             ContinuedPair::Second => sobol::SECOND_PAIR,
             ContinuedPair::Third => sobol::THIRD_PAIR,
         };
-        Vec2::new(
-            u32_to_unit_f32(scrambled_further_sobol(dx, i, h as u32)),
-            u32_to_unit_f32(scrambled_further_sobol(dy, i, (h >> 32) as u32)),
-        )
+        let [x, y] = scrambled_further_sobol_pair(
+            further,
+            anchor.shuffled_index_reversed,
+            [h as u32, (h >> 32) as u32],
+        );
+        Vec2::new(u32_to_unit_f32(x), u32_to_unit_f32(y))
     }
 
     /// [`get_2d_continuing`](Self::get_2d_continuing) when `needed`; otherwise (0, 0),
@@ -283,10 +297,11 @@ impl PixelSample {
 }
 
 /// A 2D draw whose Sobol point later draws continue: the sample index as that draw
-/// shuffled it (meaningless for samplers other than Sobol, which ignore it).
+/// shuffled it, bit-reversed (meaningless for samplers other than Sobol, which ignore
+/// it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SobolAnchor {
-    shuffled_index: u32,
+    shuffled_index_reversed: u32,
 }
 
 /// Which further dimensions of an anchor's Sobol point a continuing draw takes:
@@ -297,15 +312,13 @@ pub enum ContinuedPair {
     Third,
 }
 
-/// The Sobol pair of dimension key `key` at shuffled index `i`: dimensions 0 and 1,
-/// Owen-scrambled with a hash of the key.
+/// The Sobol pair of dimension key `key` at the shuffled index whose bit reversal is
+/// `r`: dimensions 0 and 1, Owen-scrambled with a hash of the key.
 #[inline(always)]
-fn sobol_2d_at(i: u32, key: u64) -> Vec2 {
+fn sobol_2d_at(r: u32, key: u64) -> Vec2 {
     let h = mix64(key);
-    Vec2::new(
-        u32_to_unit_f32(scrambled_sobol(0, i, h as u32)),
-        u32_to_unit_f32(scrambled_sobol(1, i, (h >> 32) as u32)),
-    )
+    let [x, y] = scrambled_sobol_pair(r, [h as u32, (h >> 32) as u32]);
+    Vec2::new(u32_to_unit_f32(x), u32_to_unit_f32(y))
 }
 
 /// The key of dimension `dim` of the pixel (or stream) `pixel_key`: what shuffles and

@@ -110,27 +110,148 @@ fn digit_image<const ENTRIES: usize, const DIGITS: usize>(
     x
 }
 
-/// The image of each 4-bit digit of the index, per further dimension, bit-reversed for
-/// scrambling in the reversed domain. Nibbles, not bytes: a shuffled sample index has
-/// random high bits, so every table entry is as likely as any other, and byte tables
-/// (16 KiB for the four dimensions) fell out of the L1 cache where these (2 KiB) stay.
-static FURTHER_NIBBLES_REVERSED: [[[u32; 16]; 8]; 4] = {
+/// The image of each 4-bit digit of the index's bit reversal, as the sample-index
+/// shuffle leaves it (see [`SOBOL01_OF_REVERSED_INDEX`]), per further dimension,
+/// bit-reversed for scrambling in the reversed domain. Nibbles, not bytes: a shuffled
+/// sample index has random high bits, so every table entry is as likely as any other,
+/// and byte tables (16 KiB for the four dimensions) fell out of the L1 cache where
+/// these (2 KiB) stay.
+static FURTHER_NIBBLES_OF_REVERSED_INDEX: [[[u32; 16]; 8]; 4] = further_tables(true);
+
+/// [`FURTHER_NIBBLES_OF_REVERSED_INDEX`] indexed by the digits of the index itself:
+/// the reference the tests hold the sampler's tables to.
+#[cfg(test)]
+static FURTHER_NIBBLES_REVERSED: [[[u32; 16]; 8]; 4] = further_tables(false);
+
+const fn further_tables(of_reversed_index: bool) -> [[[u32; 16]; 8]; 4] {
     let mut t = [[[0u32; 16]; 8]; 4];
     let mut d = 0;
     while d < 4 {
         let (s, a, m) = FURTHER_DIMENSIONS[d];
-        t[d] = digit_tables(direction_numbers(s, a, m), true);
+        let v = direction_numbers(s, a, m);
+        t[d] = digit_tables(
+            if of_reversed_index {
+                bit_order_reversed(v)
+            } else {
+                v
+            },
+            true,
+        );
         d += 1;
+    }
+    t
+}
+
+/// Owen-scrambled Sobol point `index` of further dimension `further` (an index into
+/// [`FURTHER_DIMENSIONS`]), scrambled in the reversed domain as [`scrambled_sobol`].
+#[cfg(test)]
+pub fn scrambled_further_sobol(further: usize, index: u32, seed: u32) -> u32 {
+    let reversed = digit_image(&FURTHER_NIBBLES_REVERSED[further], index);
+    laine_karras(reversed, seed).reverse_bits()
+}
+
+/// Owen-scrambled Sobol points of further dimensions `further` (x, y) at the index
+/// whose bit reversal is `index_reversed`, scrambled with `seeds`: what
+/// `scrambled_further_sobol` gives for each, with one 64-bit reversal for both.
+#[inline(always)]
+pub fn scrambled_further_sobol_pair(
+    further: [usize; 2],
+    index_reversed: u32,
+    seeds: [u32; 2],
+) -> [u32; 2] {
+    let x = digit_image(
+        &FURTHER_NIBBLES_OF_REVERSED_INDEX[further[0]],
+        index_reversed,
+    );
+    let y = digit_image(
+        &FURTHER_NIBBLES_OF_REVERSED_INDEX[further[1]],
+        index_reversed,
+    );
+    reverse_pair(laine_karras(x, seeds[0]), laine_karras(y, seeds[1]))
+}
+
+/// Owen-scrambled Sobol dimensions 0 and 1 at the index whose bit reversal is
+/// `index_reversed`, scrambled with `seeds`: [`scrambled_sobol`] of both dimensions at
+/// that index.
+///
+/// The shuffled sample index comes out of its scramble bit-reversed, and x86 has no
+/// instruction for a bit reversal (it takes about 17). Both dimensions' reversed-domain
+/// values are linear over GF(2) in the index bits, so one table of their pair per byte
+/// of the reversed index gives both in four lookups, and the two scrambled values are
+/// reversed back together as one 64-bit word: two reversals saved per 2D draw.
+#[inline(always)]
+pub fn scrambled_sobol_pair(index_reversed: u32, seeds: [u32; 2]) -> [u32; 2] {
+    let both = digit_image_pair(&SOBOL01_OF_REVERSED_INDEX, index_reversed);
+    reverse_pair(
+        laine_karras(both as u32, seeds[0]),
+        laine_karras((both >> 32) as u32, seeds[1]),
+    )
+}
+
+/// Owen-scrambled Sobol dimension 0 at the index whose bit reversal is `index_reversed`
+/// ([`scrambled_sobol`]`(0, …)` at that index).
+#[inline(always)]
+pub fn scrambled_sobol_0(index_reversed: u32, seed: u32) -> u32 {
+    let reversed = digit_image_pair(&SOBOL01_OF_REVERSED_INDEX, index_reversed) as u32;
+    laine_karras(reversed, seed).reverse_bits()
+}
+
+/// The bit reversals of `x` and `y`, by one reversal of the word that holds both.
+#[inline(always)]
+fn reverse_pair(x: u32, y: u32) -> [u32; 2] {
+    let both = (x as u64 | (y as u64) << 32).reverse_bits();
+    [(both >> 32) as u32, both as u32]
+}
+
+/// The reversed-domain values of Sobol dimensions 0 (low half) and 1 (high half) as the
+/// image of each byte of the index's bit reversal: 8 KiB.
+static SOBOL01_OF_REVERSED_INDEX: [[u64; 256]; 4] = {
+    let dim0 = digit_tables::<256, 4>(bit_order_reversed(VAN_DER_CORPUT_DIRECTIONS), true);
+    let dim1 = digit_tables::<256, 4>(bit_order_reversed(SOBOL1_DIRECTIONS), true);
+    let mut t = [[0u64; 256]; 4];
+    let mut digit = 0;
+    while digit < 4 {
+        let mut value = 0;
+        while value < 256 {
+            t[digit][value] = dim0[digit][value] as u64 | (dim1[digit][value] as u64) << 32;
+            value += 1;
+        }
+        digit += 1;
     }
     t
 };
 
-/// Owen-scrambled Sobol point `index` of further dimension `further` (an index into
-/// [`FURTHER_DIMENSIONS`]), scrambled in the reversed domain as [`scrambled_sobol`].
-#[inline]
-pub fn scrambled_further_sobol(further: usize, index: u32, seed: u32) -> u32 {
-    let reversed = digit_image(&FURTHER_NIBBLES_REVERSED[further], index);
-    laine_karras(reversed, seed).reverse_bits()
+/// Dimension 0, the van der Corput sequence: index bit k is the fraction's bit 31 − k.
+const VAN_DER_CORPUT_DIRECTIONS: [u32; 32] = {
+    let mut v = [0u32; 32];
+    let mut k = 0;
+    while k < 32 {
+        v[k] = 1 << (31 - k);
+        k += 1;
+    }
+    v
+};
+
+/// Direction numbers indexed by the bits of the index's reversal: bit k of the reversed
+/// index is bit 31 − k of the index.
+const fn bit_order_reversed(v: [u32; 32]) -> [u32; 32] {
+    let mut w = [0u32; 32];
+    let mut k = 0;
+    while k < 32 {
+        w[k] = v[31 - k];
+        k += 1;
+    }
+    w
+}
+
+/// [`digit_image`] of a table of pairs.
+#[inline(always)]
+fn digit_image_pair(tables: &[[u64; 256]; 4], index: u32) -> u64 {
+    let mut x = 0;
+    for (digit, table) in tables.iter().enumerate() {
+        x ^= table[(index >> (8 * digit)) as usize & 255];
+    }
+    x
 }
 
 /// Owen-scrambled Sobol point `index` of dimension `dim` (0 or 1). The scramble works
@@ -164,14 +285,14 @@ fn laine_karras(mut x: u32, seed: u32) -> u32 {
 /// applied to the bit-reversed value, flips each bit depending only on the bits above
 /// it. The constants are N. Vegdahl's improved hash ("Building a Better LK Hash", 2021).
 pub fn owen_scramble(v: u32, seed: u32) -> u32 {
-    owen_scramble_reversed(v.reverse_bits(), seed)
+    owen_scramble_reversed(v.reverse_bits(), seed).reverse_bits()
 }
 
-/// [`owen_scramble`] of the value whose bit reversal is `reversed`: for a caller that
-/// scrambles one value under many seeds and reverses it once.
+/// [`owen_scramble`] of the value whose bit reversal is `reversed`, left bit-reversed:
+/// for a caller that reads the scrambled value through tables of its reversal.
 #[inline(always)]
 pub fn owen_scramble_reversed(reversed: u32, seed: u32) -> u32 {
-    laine_karras(reversed, seed).reverse_bits()
+    laine_karras(reversed, seed)
 }
 
 #[cfg(test)]
@@ -240,6 +361,45 @@ mod tests {
                     let x = scrambled_further_sobol(further, i, 0) >> (32 - k);
                     assert!(!std::mem::replace(&mut seen[x as usize], true));
                 }
+            }
+        }
+    }
+
+    /// The pair draws from a reversed index are the single-dimension scrambles at the
+    /// index itself.
+    #[test]
+    fn pairs_from_the_reversed_index_equal_the_scrambles_of_each_dimension() {
+        let mut rng = radiant_math::hash::Pcg32::new(5, 9);
+        for n in 0..2000 {
+            let i = match n {
+                0 => 0,
+                1 => u32::MAX,
+                2 => 0x8000_0001,
+                _ => rng.next_u32(),
+            };
+            let seeds = [rng.next_u32(), rng.next_u32()];
+            let r = i.reverse_bits();
+            assert_eq!(
+                scrambled_sobol_pair(r, seeds),
+                [
+                    scrambled_sobol(0, i, seeds[0]),
+                    scrambled_sobol(1, i, seeds[1])
+                ],
+                "index {i:#x}"
+            );
+            assert_eq!(
+                scrambled_sobol_0(r, seeds[0]),
+                scrambled_sobol(0, i, seeds[0])
+            );
+            for further in [[0, 1], [2, 3], [3, 0]] {
+                assert_eq!(
+                    scrambled_further_sobol_pair(further, r, seeds),
+                    [
+                        scrambled_further_sobol(further[0], i, seeds[0]),
+                        scrambled_further_sobol(further[1], i, seeds[1])
+                    ],
+                    "index {i:#x}, dimensions {further:?}"
+                );
             }
         }
     }
