@@ -34,17 +34,18 @@ pub struct SolidAngleSample {
 /// angle seen from `reference`: dω = |cos θ| dA / r², so p_ω = p_A r² / |cos θ|.
 /// Returns 0 where the conversion is degenerate (coincident points, grazing sample),
 /// i.e. where the sample cannot carry any contribution.
+///
+/// With |cos θ| = |n · w| / r for w = p − reference, that is p_A r² · (r / |n · w|):
+/// one division after the square root instead of two (a light sample's direction waits
+/// on this density).
 pub fn area_pdf_to_solid_angle(pdf_area: f32, reference: Vec3, p: Vec3, n: Vec3) -> f32 {
     let w = p - reference;
     let dist2 = w.length_squared();
-    if dist2 == 0.0 {
+    let n_dot_w = n.dot(w).abs();
+    if dist2 == 0.0 || n_dot_w == 0.0 {
         return 0.0;
     }
-    let cos = n.dot(w).abs() / dist2.sqrt();
-    if cos == 0.0 {
-        return 0.0;
-    }
-    let pdf = pdf_area * dist2 / cos;
+    let pdf = (pdf_area * dist2) * (dist2.sqrt() / n_dot_w);
     if pdf.is_finite() { pdf } else { 0.0 }
 }
 
@@ -75,4 +76,44 @@ pub enum ShapeError {
     EmptyZRange { z_min: f32, z_max: f32, radius: f32 },
     #[error("phimax must lie in (0, 360] degrees, got {0}")]
     BadPhiMax(f32),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// p_A r² / |cos θ| at points seen head-on, obliquely and from behind, at scales
+    /// from 10⁻³ to 10⁶, against the same formula in f64; 0 where degenerate.
+    #[test]
+    fn area_density_becomes_solid_angle_density() {
+        for scale in [1e-3f32, 1.0, 1e6] {
+            let reference = Vec3::new(0.3, -0.2, 0.1) * scale;
+            for (offset, n) in [
+                (Vec3::new(0.0, 0.0, 2.0), Vec3::new(0.0, 0.0, -1.0)),
+                (Vec3::new(1.0, 0.5, 2.0), Vec3::new(0.6, 0.0, -0.8)),
+                (Vec3::new(-3.0, 1.0, 0.5), Vec3::new(0.0, 1.0, 0.0)),
+            ] {
+                let p = reference + offset * scale;
+                let pdf_area = 0.25 / (scale * scale);
+                let w = (p - reference).as_dvec3();
+                let r2 = w.length_squared();
+                let cos = n.as_dvec3().dot(w).abs() / r2.sqrt();
+                let expected = pdf_area as f64 * r2 / cos;
+                let got = area_pdf_to_solid_angle(pdf_area, reference, p, n) as f64;
+                assert!(
+                    (got - expected).abs() <= 1e-5 * expected,
+                    "scale {scale}, offset {offset}: {got} against {expected}"
+                );
+            }
+            let grazing = reference + Vec3::new(1.0, 0.0, 0.0) * scale;
+            assert_eq!(
+                area_pdf_to_solid_angle(1.0, reference, grazing, Vec3::Z),
+                0.0
+            );
+            assert_eq!(
+                area_pdf_to_solid_angle(1.0, reference, reference, Vec3::Z),
+                0.0
+            );
+        }
+    }
 }
