@@ -471,13 +471,8 @@ fn build_leaves(node: &super::build::BuildNode, order: &[u32], out: &mut Vec<(Aa
 /// range.
 #[test]
 fn the_cornell_boxs_walls_are_leaves_of_their_own_at_any_scale() {
-    let settings = super::build::BuildSettings {
-        leaf_block: 4,
-        max_leaf: 8,
-        leaf_test: 8,
-        max_cluster_leaf: 16,
-        cost_traversal: 1.0,
-    };
+    // The triangle BVH's settings, as the renderer builds with them.
+    let settings = super::triangle_bvh::SETTINGS;
     // The light marked, as the renderer builds it (unmarked, it would share a flat leaf
     // with the ceiling 0.1 mm above it).
     let kinds: Vec<u8> = cornell_box_emitting()
@@ -549,13 +544,8 @@ fn cornell_box_emitting() -> Vec<bool> {
 /// and for random soups with random emitters.
 #[test]
 fn emitting_triangles_are_in_leaves_of_their_own() {
-    let settings = super::build::BuildSettings {
-        leaf_block: 4,
-        max_leaf: 8,
-        leaf_test: 8,
-        max_cluster_leaf: 16,
-        cost_traversal: 1.0,
-    };
+    // The triangle BVH's settings, as the renderer builds with them.
+    let settings = super::triangle_bvh::SETTINGS;
     let emitting = cornell_box_emitting();
     assert_eq!(emitting.iter().filter(|&&e| e).count(), 2);
     let kinds: Vec<u8> = emitting.iter().map(|&e| u8::from(e)).collect();
@@ -714,13 +704,8 @@ fn box_triangles(lo: Vec3, hi: Vec3) -> Vec<[Vec3; 3]> {
 /// absorbs them). The light's triangles are a leaf of their own as well.
 #[test]
 fn separate_walls_of_a_room_are_flat_leaves_at_any_scale() {
-    let settings = super::build::BuildSettings {
-        leaf_block: 4,
-        max_leaf: 8,
-        leaf_test: 8,
-        max_cluster_leaf: 16,
-        cost_traversal: 1.0,
-    };
+    // The triangle BVH's settings, as the renderer builds with them.
+    let settings = super::triangle_bvh::SETTINGS;
     for (offset, scale) in [
         (Vec3::ZERO, 1.0),
         (Vec3::new(-3e-3, 2e-3, 7e-3), 1e-5),
@@ -805,15 +790,10 @@ fn separate_walls_of_a_room_are_flat_leaves_at_any_scale() {
 /// so each kind's primitives form one subtree of their own (random soups, random kinds).
 #[test]
 fn clusters_of_one_kind_merge_first() {
-    use super::build::{BuildNode, BuildSettings, PrimRef};
+    use super::build::{BuildNode, PrimRef};
     use super::cluster::{Costs, RayModel, cluster_range};
-    let settings = BuildSettings {
-        leaf_block: 4,
-        max_leaf: 8,
-        leaf_test: 8,
-        max_cluster_leaf: 16,
-        cost_traversal: 1.0,
-    };
+    // The triangle BVH's settings, as the renderer builds with them.
+    let settings = super::triangle_bvh::SETTINGS;
     /// The kinds under `node` (a bit each), and the number of maximal one-kind subtrees
     /// found under it, per kind.
     fn kinds_under(node: &BuildNode, order: &[u32], kinds: &[u8], pure: &mut [u32; 2]) -> u8 {
@@ -876,13 +856,8 @@ fn clusters_of_one_kind_merge_first() {
 /// of its own. At three scales and offsets.
 #[test]
 fn the_cornell_box_is_one_wide_node_of_whole_shapes_at_any_scale() {
-    let settings = super::build::BuildSettings {
-        leaf_block: 4,
-        max_leaf: 8,
-        leaf_test: 8,
-        max_cluster_leaf: 16,
-        cost_traversal: 1.0,
-    };
+    // The triangle BVH's settings, as the renderer builds with them.
+    let settings = super::triangle_bvh::SETTINGS;
     let emitting = cornell_box_emitting();
     let kinds: Vec<u8> = emitting.iter().map(|&e| u8::from(e)).collect();
     for (offset, scale) in [

@@ -48,7 +48,7 @@ pub struct TriangleBvh {
 /// 0.5) or single-block leaves made deeper trees and slower traversal. The bottom-up
 /// build of small room-spanning ranges counts 8-triangle kernel tests and allows leaves
 /// of up to 16 (cluster.rs).
-const SETTINGS: BuildSettings = BuildSettings {
+pub(super) const SETTINGS: BuildSettings = BuildSettings {
     leaf_block: 4,
     max_leaf: 8,
     leaf_test: 8,
