@@ -96,14 +96,18 @@ const fn digit_tables<const ENTRIES: usize, const DIGITS: usize>(
     tables
 }
 
-/// The point of `index` from a dimension's [`digit_tables`]: its digits' images XORed.
+/// The point of `index` from a dimension's [`digit_tables`] (or from a table of two
+/// dimensions' points side by side): its digits' images XORed.
 #[inline(always)]
-fn digit_image<const ENTRIES: usize, const DIGITS: usize>(
-    tables: &[[u32; ENTRIES]; DIGITS],
+fn digit_image<T, const ENTRIES: usize, const DIGITS: usize>(
+    tables: &[[T; ENTRIES]; DIGITS],
     index: u32,
-) -> u32 {
+) -> T
+where
+    T: Copy + Default + std::ops::BitXorAssign,
+{
     let bits = 32 / DIGITS;
-    let mut x = 0;
+    let mut x = T::default();
     for (digit, table) in tables.iter().enumerate() {
         x ^= table[(index >> (bits * digit)) as usize & (ENTRIES - 1)];
     }
@@ -181,7 +185,7 @@ pub fn scrambled_further_sobol_pair(
 /// reversed back together as one 64-bit word: two reversals saved per 2D draw.
 #[inline(always)]
 pub fn scrambled_sobol_pair(index_reversed: u32, seeds: [u32; 2]) -> [u32; 2] {
-    let both = digit_image_pair(&SOBOL01_OF_REVERSED_INDEX, index_reversed);
+    let both = digit_image(&SOBOL01_OF_REVERSED_INDEX, index_reversed);
     reverse_pair(
         laine_karras(both as u32, seeds[0]),
         laine_karras((both >> 32) as u32, seeds[1]),
@@ -192,7 +196,7 @@ pub fn scrambled_sobol_pair(index_reversed: u32, seeds: [u32; 2]) -> [u32; 2] {
 /// ([`scrambled_sobol`]`(0, …)` at that index).
 #[inline(always)]
 pub fn scrambled_sobol_0(index_reversed: u32, seed: u32) -> u32 {
-    let reversed = digit_image_pair(&SOBOL01_OF_REVERSED_INDEX, index_reversed) as u32;
+    let reversed = digit_image(&SOBOL01_OF_REVERSED_INDEX, index_reversed) as u32;
     laine_karras(reversed, seed).reverse_bits()
 }
 
@@ -242,16 +246,6 @@ const fn bit_order_reversed(v: [u32; 32]) -> [u32; 32] {
         k += 1;
     }
     w
-}
-
-/// [`digit_image`] of a table of pairs.
-#[inline(always)]
-fn digit_image_pair(tables: &[[u64; 256]; 4], index: u32) -> u64 {
-    let mut x = 0;
-    for (digit, table) in tables.iter().enumerate() {
-        x ^= table[(index >> (8 * digit)) as usize & 255];
-    }
-    x
 }
 
 /// Owen-scrambled Sobol point `index` of dimension `dim` (0 or 1). The scramble works
