@@ -7,6 +7,7 @@
 
 pub mod color;
 pub mod distribution;
+pub mod divisor;
 pub mod equal_area;
 pub mod frame;
 pub mod hash;

@@ -12,6 +12,7 @@
 //! scrambled point has a random tail instead of trailing zeros.
 
 use radiant_math::ONE_MINUS_EPSILON;
+use radiant_math::divisor::Divisor;
 use radiant_math::hash::{mix64, u32_to_unit_f32};
 use radiant_scene::DigitRandomization;
 
@@ -66,32 +67,37 @@ pub fn randomized_radical_inverse(
         };
         return u32_to_unit_f32(bits);
     }
-    let base = PRIMES[prime] as u64;
-    let inv_base = 1.0 / base as f64;
-    let mut rest = index as u64;
+    let Base {
+        divisor: base,
+        less_one: base_minus_one,
+        inverse: inv_base,
+        digits,
+    } = BASES[prime];
+    let mut rest = index;
     let mut weight = inv_base;
     let mut value = 0.0f64;
     // The hash the next digit's permutation is drawn from: for Owen scrambling it takes
     // in every digit produced so far, so each prefix interval is permuted on its own.
     let mut prefix = key;
-    let mut position = 0u64;
-    while weight > 1.0 / 4_294_967_296.0 {
-        let digit = rest % base;
-        rest /= base;
+    for position in 0..digits as u64 {
+        let (next, digit) = base.div_rem(rest);
+        rest = next;
         let permuted = match randomization {
             DigitRandomization::None => digit,
-            DigitRandomization::PermuteDigits => {
-                affine_permutation(digit, base, mix64(key ^ position.wrapping_mul(PHI)))
-            }
+            DigitRandomization::PermuteDigits => affine_permutation(
+                digit,
+                base,
+                base_minus_one,
+                mix64(key ^ position.wrapping_mul(PHI)),
+            ),
             DigitRandomization::Owen => {
-                let p = affine_permutation(digit, base, prefix);
-                prefix = mix64(prefix ^ (digit + 1).wrapping_mul(PHI));
+                let p = affine_permutation(digit, base, base_minus_one, prefix);
+                prefix = mix64(prefix ^ (digit as u64 + 1).wrapping_mul(PHI));
                 p
             }
         };
         value += permuted as f64 * weight;
         weight *= inv_base;
-        position += 1;
         if rest == 0 && randomization == DigitRandomization::None {
             break;
         }
@@ -103,17 +109,123 @@ pub fn randomized_radical_inverse(
 const PHI: u64 = 0x9e37_79b9_7f4a_7c15;
 
 /// d ↦ (a·d + c) mod b with a ∈ [1, b), c ∈ [0, b) taken from `hash`: a permutation of
-/// the digits of a prime base, and c makes every digit equally likely.
-#[inline]
-fn affine_permutation(digit: u64, base: u64, hash: u64) -> u64 {
-    let a = 1 + (hash >> 32) % (base - 1).max(1);
-    let c = (hash & 0xffff_ffff) % base;
-    (a * digit + c) % base
+/// the digits of a prime base, and c makes every digit equally likely. Every operand is
+/// below 2³² (a·d + c < b² for the bases here), so the divisions are by multiplication.
+#[inline(always)]
+fn affine_permutation(digit: u32, base: Divisor, base_minus_one: Divisor, hash: u64) -> u32 {
+    let a = 1 + base_minus_one.remainder((hash >> 32) as u32);
+    let c = base.remainder(hash as u32);
+    base.remainder(a * digit + c)
+}
+
+/// What the digit loop needs of a prime base, computed once: the base and the base less
+/// one as divisors by multiplication (the digits and the permutations' multipliers),
+/// 1/b, and how many digits it takes until b^-k falls to 2^-32.
+#[derive(Clone, Copy)]
+struct Base {
+    divisor: Divisor,
+    less_one: Divisor,
+    inverse: f64,
+    digits: u32,
+}
+
+/// Base 2 takes the bitwise path and is never divided by; its entry holds 2 as "the
+/// base less one" only because a divisor by multiplication needs d ≥ 2.
+static BASES: [Base; PRIME_COUNT] = bases();
+
+const fn bases() -> [Base; PRIME_COUNT] {
+    let mut table = [Base {
+        divisor: Divisor::new(2),
+        less_one: Divisor::new(2),
+        inverse: 0.5,
+        digits: 32,
+    }; PRIME_COUNT];
+    let mut i = 1;
+    while i < PRIME_COUNT {
+        let inverse = 1.0 / PRIMES[i] as f64;
+        // The weights as the loop forms them, by repeated products.
+        let (mut weight, mut digits) = (inverse, 0);
+        while weight > 1.0 / 4_294_967_296.0 {
+            weight *= inverse;
+            digits += 1;
+        }
+        table[i] = Base {
+            divisor: Divisor::new(PRIMES[i]),
+            less_one: Divisor::new(PRIMES[i] - 1),
+            inverse,
+            digits,
+        };
+        i += 1;
+    }
+    table
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The radical inverse as first written, with the hardware's divisions and the
+    /// loop ending on the weight: the reference for the tables and the division by
+    /// multiplication.
+    fn by_division(index: u32, prime: usize, key: u64, randomization: DigitRandomization) -> f32 {
+        let base = PRIMES[prime] as u64;
+        let permute = |digit: u64, hash: u64| {
+            let a = 1 + (hash >> 32) % (base - 1);
+            let c = (hash & 0xffff_ffff) % base;
+            (a * digit + c) % base
+        };
+        let inv_base = 1.0 / base as f64;
+        let (mut rest, mut weight, mut value) = (index as u64, inv_base, 0.0f64);
+        let (mut prefix, mut position) = (key, 0u64);
+        while weight > 1.0 / 4_294_967_296.0 {
+            let digit = rest % base;
+            rest /= base;
+            let permuted = match randomization {
+                DigitRandomization::None => digit,
+                DigitRandomization::PermuteDigits => {
+                    permute(digit, mix64(key ^ position.wrapping_mul(PHI)))
+                }
+                DigitRandomization::Owen => {
+                    let p = permute(digit, prefix);
+                    prefix = mix64(prefix ^ (digit + 1).wrapping_mul(PHI));
+                    p
+                }
+            };
+            value += permuted as f64 * weight;
+            weight *= inv_base;
+            position += 1;
+            if rest == 0 && randomization == DigitRandomization::None {
+                break;
+            }
+        }
+        (value as f32).min(ONE_MINUS_EPSILON)
+    }
+
+    #[test]
+    fn the_tables_give_the_points_of_plain_division_bit_for_bit() {
+        let mut rng = radiant_math::hash::Pcg32::new(3, 9);
+        for randomization in [
+            DigitRandomization::None,
+            DigitRandomization::PermuteDigits,
+            DigitRandomization::Owen,
+        ] {
+            for prime in [1, 2, 3, 4, 10, 100, 511, 512, PRIME_COUNT - 1] {
+                for i in 0..3000u32 {
+                    let index = match i % 3 {
+                        0 => i,
+                        1 => rng.next_u32(),
+                        _ => u32::MAX - i,
+                    };
+                    let key = mix64(i as u64 ^ (prime as u64) << 32);
+                    assert_eq!(
+                        randomized_radical_inverse(index, prime, key, randomization).to_bits(),
+                        by_division(index, prime, key, randomization).to_bits(),
+                        "{randomization:?} prime {prime} index {index}"
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn the_prime_table_holds_the_primes() {
