@@ -6,12 +6,20 @@
 use glam::Vec2;
 
 /// Discrete distribution over `n` items with weights `w_i >= 0`. Sampling inverts the
-/// CDF by binary search, so sampling is O(log n) and exactly reproducible.
+/// CDF, so it is monotone in u (stratified u give stratified items) and exactly
+/// reproducible. A guide table (Chen & Asau, "On generating random variates from an
+/// empirical distribution", AIIE Transactions 6(2), 1974) narrows the search to the
+/// items of one of 2^k equal intervals of u, about one item on average: a large
+/// distribution (an environment image's rows) is then two memory reads instead of a
+/// binary search's log₂ n dependent ones.
 #[derive(Clone, Debug, Default)]
 pub struct Distribution1D {
     /// Normalised CDF with `cdf[0] = 0` and `cdf[n] = 1`.
     cdf: Vec<f64>,
     pmf: Vec<f32>,
+    /// `guide[k]`: the item that u = k / K falls in, for K = `guide.len() − 1`, a power
+    /// of two (so that k / K and u · K are exact).
+    guide: Vec<u32>,
     total: f64,
 }
 
@@ -36,7 +44,26 @@ impl Distribution1D {
             *last = 1.0;
         }
         let pmf = (0..n).map(|i| (cdf[i + 1] - cdf[i]) as f32).collect();
-        Distribution1D { cdf, pmf, total }
+        let mut d = Distribution1D {
+            cdf,
+            pmf,
+            guide: Vec::new(),
+            total,
+        };
+        if n > 0 {
+            let intervals = n.next_power_of_two();
+            let mut item = 0;
+            d.guide = (0..=intervals)
+                .map(|k| {
+                    let u = k as f64 / intervals as f64;
+                    while item + 1 < n && d.cdf[item + 1] <= u {
+                        item += 1;
+                    }
+                    item as u32
+                })
+                .collect();
+        }
+        d
     }
 
     pub fn len(&self) -> usize {
@@ -62,28 +89,36 @@ impl Distribution1D {
         let n = self.pmf.len();
         debug_assert!(n > 0, "sampling an empty distribution");
         let u64 = u as f64;
-        // First index i with cdf[i+1] > u.
-        let mut lo = 0usize;
-        let mut hi = n - 1;
-        while lo < hi {
-            let mid = (lo + hi) / 2;
-            if self.cdf[mid + 1] <= u64 {
-                lo = mid + 1;
-            } else {
-                hi = mid;
-            }
+        // The item is the first i with cdf[i+1] > u (the last item if none). u lies in
+        // interval k of the guide, [k / K, (k + 1) / K), so the item lies between the
+        // items of the interval's ends; a binary search finishes between them.
+        let intervals = self.guide.len() - 1;
+        let k = ((u64 * intervals as f64) as usize).min(intervals - 1);
+        let mut lo = self.guide[k] as usize;
+        let mut len = self.guide[k + 1] as usize + 1 - lo;
+        // Steps that choose without branching: which half holds u is a coin flip. The
+        // interval [lo, lo + len) holds the item; a step keeps its upper part when item
+        // lo + half − 1 ends at or below u, and otherwise a part at least as long as
+        // the lower half, which holds it then.
+        while len > 1 {
+            let half = len / 2;
+            lo = std::hint::select_unpredictable(self.cdf[lo + half] <= u64, lo + half, lo);
+            len -= half;
         }
-        // Skip zero-probability items that a u exactly on a CDF step could land on.
-        while lo + 1 < n && self.pmf[lo] == 0.0 {
+        // Skip zero-probability items that a u exactly on a CDF step could land on. The
+        // probability is read as the CDF's step, which `pmf` holds too (the same
+        // expression), so that no third array is read.
+        let step = |i: usize| self.cdf[i + 1] - self.cdf[i];
+        while lo + 1 < n && step(lo) as f32 == 0.0 {
             lo += 1;
         }
-        let width = self.cdf[lo + 1] - self.cdf[lo];
+        let width = step(lo);
         let remapped = if width > 0.0 {
             (((u64 - self.cdf[lo]) / width) as f32).clamp(0.0, super::ONE_MINUS_EPSILON)
         } else {
             0.0
         };
-        (lo, self.pmf[lo], remapped)
+        (lo, width as f32, remapped)
     }
 }
 
@@ -212,6 +247,39 @@ mod tests {
         assert_eq!(counts[1], 0);
         assert!((counts[0] as f32 / n as f32 - 0.125).abs() < 1e-3);
         assert!((counts[3] as f32 / n as f32 - 0.5).abs() < 1e-3);
+    }
+
+    /// The search finds the item a linear scan of the CDF finds, for every length from
+    /// 1 to 70 (odd and even halves, powers of two and their neighbours), with runs of
+    /// zero weights, and for u on the CDF's steps as well as between them.
+    #[test]
+    fn the_search_finds_the_first_item_ending_above_u() {
+        let mut rng = crate::hash::Pcg32::new(77, 2);
+        for n in 1..=70 {
+            for round in 0..20 {
+                let weights: Vec<f32> = (0..n)
+                    .map(|_| match rng.next_u32() % 4 {
+                        0 if round % 2 == 0 => 0.0,
+                        1 => 0.25,
+                        _ => rng.uniform(),
+                    })
+                    .collect();
+                let d = Distribution1D::new(&weights);
+                let steps = d
+                    .cdf
+                    .iter()
+                    .map(|&c| (c as f32).min(crate::ONE_MINUS_EPSILON));
+                let us: Vec<f32> = (0..50).map(|_| rng.uniform()).chain(steps).collect();
+                for u in us {
+                    let scan = (0..n).find(|&i| d.cdf[i + 1] > u as f64).unwrap_or(n - 1);
+                    let mut expected = scan;
+                    while expected + 1 < n && d.pmf[expected] == 0.0 {
+                        expected += 1;
+                    }
+                    assert_eq!(d.sample(u).0, expected, "n {n}, u {u}, weights {weights:?}");
+                }
+            }
+        }
     }
 
     #[test]
