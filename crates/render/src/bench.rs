@@ -218,7 +218,7 @@ pub fn environment_benchmark(size: usize, samples: usize) -> EnvironmentFigures 
         radiance: radiant_math::Rgb::WHITE,
         map: Some(Arc::new(EnvironmentMap::new(
             size,
-            Arc::new(sun_sky_image(size)),
+            &sun_sky_image(size),
             radiant_math::Rgb::WHITE,
             glam::Mat3::IDENTITY,
         ))),

@@ -87,7 +87,7 @@ fn env_light(size: usize, rotation: Mat3) -> Light {
         radiance: Rgb::WHITE,
         map: Some(Arc::new(EnvironmentMap::new(
             size,
-            Arc::new(sky_image(size)),
+            &sky_image(size),
             Rgb::WHITE,
             rotation,
         ))),

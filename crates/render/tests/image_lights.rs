@@ -62,7 +62,7 @@ fn gonio_light() -> GoniometricLight {
         .map(|p| Rgb::splat((p.r + p.g + p.b) / 3.0))
         .collect();
     let rotation = Mat3::from_rotation_x(0.4) * Mat3::from_cols(Vec3::X, Vec3::Z, Vec3::Y);
-    let map = EnvironmentMap::new(n, Arc::new(grey), Rgb::new(2.0, 1.0, 0.5), rotation);
+    let map = EnvironmentMap::new(n, &grey, Rgb::new(2.0, 1.0, 0.5), rotation);
     GoniometricLight::new(Vec3::new(0.5, -1.0, 2.0), Arc::new(map))
 }
 

@@ -22,8 +22,6 @@
 //! density is then zero where BSDF sampling must cover alone, which the balance or
 //! power heuristic handles (the BSDF's weight there is 1).
 
-use std::sync::Arc;
-
 use glam::{Mat3, Vec2, Vec3};
 
 use super::{LightLeSample, LightLiSample, LightPoint, LightSampleContext, SceneSphere};
@@ -35,9 +33,10 @@ use radiant_math::{Distribution2D, PI, Transform};
 #[derive(Clone)]
 pub struct EnvironmentMap {
     size: usize,
-    pixels: Arc<Vec<Rgb>>,
-    /// Multiplies every pixel (`scale`, `illuminance`).
-    scale: Rgb,
+    /// Per pixel, what a direction's lookup reads, side by side: one memory access
+    /// for a light sample's radiance and density (the image and the densities'
+    /// arrays apart were three, each likely a cache miss in a large image).
+    texels: Vec<Texel>,
     /// Rotation from the light's frame to render space, and back (its transpose).
     render_from_light: Mat3,
     light_from_render: Mat3,
@@ -53,7 +52,6 @@ impl std::fmt::Debug for EnvironmentMap {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("EnvironmentMap")
             .field("size", &self.size)
-            .field("scale", &self.scale)
             .field("mean", &self.mean)
             .finish_non_exhaustive()
     }
@@ -81,6 +79,15 @@ pub fn rotation_of(xf: &Transform) -> (Mat3, bool) {
         x.cross(y)
     };
     (Mat3::from_cols(x, y, z), similar)
+}
+
+/// A pixel's radiance (scaled) and its densities per unit area of the square under
+/// the plain and the compensated distributions.
+#[derive(Clone, Copy, Debug)]
+struct Texel {
+    radiance: Rgb,
+    plain: f32,
+    compensated: f32,
 }
 
 /// An environment image as read: `size * size` linear RGB values, row 0 at v = 0.
@@ -114,12 +121,7 @@ impl EnvironmentPicture {
 impl EnvironmentMap {
     /// `pixels`: `size * size` linear RGB values, row 0 at v = 0; each is multiplied
     /// by `scale`. `render_from_light` should be a rotation (see [`rotation_of`]).
-    pub fn new(
-        size: usize,
-        pixels: Arc<Vec<Rgb>>,
-        scale: Rgb,
-        render_from_light: Mat3,
-    ) -> EnvironmentMap {
+    pub fn new(size: usize, pixels: &[Rgb], scale: Rgb, render_from_light: Mat3) -> EnvironmentMap {
         assert!(size > 0 && pixels.len() == size * size);
         let lum: Vec<f32> = pixels
             .iter()
@@ -137,19 +139,35 @@ impl EnvironmentMap {
             }
         }
         let n = pixels.len() as f64;
+        let plain = Distribution2D::new(&lum, size, size);
+        // A constant image has nothing above its mean: all zero, which falls back to
+        // uniform sampling — the right density for it.
+        let compensated = Distribution2D::new(&compensated, size, size);
+        let texels = pixels
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| {
+                let center = Vec2::new(
+                    ((k % size) as f32 + 0.5) / size as f32,
+                    ((k / size) as f32 + 0.5) / size as f32,
+                );
+                Texel {
+                    radiance: p * scale,
+                    plain: plain.pdf(center),
+                    compensated: compensated.pdf(center),
+                }
+            })
+            .collect();
         EnvironmentMap {
             size,
-            plain: Distribution2D::new(&lum, size, size),
-            // A constant image has nothing above its mean: all zero, which falls back
-            // to uniform sampling — the right density for it.
-            compensated: Distribution2D::new(&compensated, size, size),
+            texels,
+            plain,
+            compensated,
             mean: Rgb::new(
                 (sum[0] / n) as f32,
                 (sum[1] / n) as f32,
                 (sum[2] / n) as f32,
             ),
-            pixels,
-            scale,
             light_from_render: render_from_light.transpose(),
             render_from_light,
         }
@@ -172,29 +190,39 @@ impl EnvironmentMap {
         }
     }
 
-    fn texel(&self, st: Vec2) -> Rgb {
+    /// The pixel holding `st`, as [`Distribution2D::cell`] finds it.
+    fn texel(&self, st: Vec2) -> &Texel {
         let n = self.size;
         let x = ((st.x * n as f32).max(0.0) as usize).min(n - 1);
         let y = ((st.y * n as f32).max(0.0) as usize).min(n - 1);
-        self.pixels[y * n + x] * self.scale
+        &self.texels[y * n + x]
+    }
+
+    /// The pixel seen in direction `d` (render space, any length); `None` for d = 0.
+    fn texel_towards(&self, d: Vec3) -> Option<&Texel> {
+        let w = (self.light_from_render * d).normalize_or_zero();
+        (w != Vec3::ZERO).then(|| self.texel(sphere_to_square(w)))
+    }
+
+    /// Solid-angle density of a texel under the distribution for `ctx`.
+    fn density(ctx: &LightSampleContext, texel: &Texel) -> f32 {
+        let per_area = if ctx.mis_with_bsdf {
+            texel.compensated
+        } else {
+            texel.plain
+        };
+        per_area / SOLID_ANGLE_PER_AREA
     }
 
     /// Radiance arriving from direction `d` (render space, any length).
     pub fn radiance(&self, d: Vec3) -> Rgb {
-        let w = (self.light_from_render * d).normalize_or_zero();
-        if w == Vec3::ZERO {
-            return Rgb::BLACK;
-        }
-        self.texel(sphere_to_square(w))
+        self.texel_towards(d).map_or(Rgb::BLACK, |t| t.radiance)
     }
 
     /// Solid-angle density of `sample_li` from `ctx` for the unit direction `wi`.
     pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32 {
-        let w = (self.light_from_render * wi).normalize_or_zero();
-        if w == Vec3::ZERO {
-            return 0.0;
-        }
-        self.distribution(ctx).pdf(sphere_to_square(w)) / SOLID_ANGLE_PER_AREA
+        self.texel_towards(wi)
+            .map_or(0.0, |t| Self::density(ctx, t))
     }
 
     /// A direction of arrival by the density for `ctx`; `None` when it carries nothing.
@@ -209,8 +237,8 @@ impl EnvironmentMap {
         // Radiance and density of the direction as `environment` and `pdf_li` see it:
         // on a pixel edge, the round trip through the direction may land in the
         // neighbouring pixel, and sample and lookup must agree there.
-        let li = self.radiance(wi);
-        let pdf = self.pdf_li(ctx, wi);
+        let texel = self.texel_towards(wi)?;
+        let (li, pdf) = (texel.radiance, Self::density(ctx, texel));
         if li.is_black() || pdf <= 0.0 {
             return None;
         }
@@ -236,11 +264,8 @@ impl EnvironmentMap {
 
     /// Solid-angle density of `sample_direction` for the direction `w`.
     pub fn plain_pdf(&self, w: Vec3) -> f32 {
-        let l = (self.light_from_render * w).normalize_or_zero();
-        if l == Vec3::ZERO {
-            return 0.0;
-        }
-        self.plain.pdf(sphere_to_square(l)) / SOLID_ANGLE_PER_AREA
+        self.texel_towards(w)
+            .map_or(0.0, |t| t.plain / SOLID_ANGLE_PER_AREA)
     }
 
     /// Flux through the scene's disk: mean radiance × 4π sr × π R².

@@ -516,7 +516,7 @@ mod tests {
                 Vec3::new(-1.0, -2.0, 0.5),
                 std::sync::Arc::new(EnvironmentMap::new(
                     4,
-                    std::sync::Arc::new(grey),
+                    &grey,
                     Rgb::WHITE,
                     glam::Mat3::IDENTITY,
                 )),

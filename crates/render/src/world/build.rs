@@ -248,7 +248,7 @@ fn light_from_desc(l: &LightDesc, warnings: &mut Vec<Warning>) -> Result<Light, 
                 radiance: scale,
                 map: Some(Arc::new(EnvironmentMap::new(
                     picture.size,
-                    Arc::new(picture.pixels),
+                    &picture.pixels,
                     scale,
                     rotation,
                 ))),
@@ -397,7 +397,7 @@ fn goniometric_light(
         loc,
         warnings,
     );
-    let map = EnvironmentMap::new(width, Arc::new(grey), intensity * k, rotation * swap_yz);
+    let map = EnvironmentMap::new(width, &grey, intensity * k, rotation * swap_yz);
     Ok(Light::Goniometric(Arc::new(GoniometricLight::new(
         position,
         Arc::new(map),
