@@ -37,8 +37,8 @@ pub fn bilinear(level: &Level, st: Vec2, wrap: WrapMode) -> Rgb {
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
     let (x0, y0) = (x0 as i64, y0 as i64);
-    let t = |dx: i64, dy: i64| level.texel(x0 + dx, y0 + dy, wrap);
-    (t(0, 0) * (1.0 - fx) + t(1, 0) * fx) * (1.0 - fy) + (t(0, 1) * (1.0 - fx) + t(1, 1) * fx) * fy
+    let [t00, t10, t01, t11] = level.quad(x0, y0, wrap);
+    (t00 * (1.0 - fx) + t10 * fx) * (1.0 - fy) + (t01 * (1.0 - fx) + t11 * fx) * fy
 }
 
 /// The continuous pyramid level where a footprint `width` (in st units) covers one

@@ -49,6 +49,39 @@ impl Level {
         self.texels[y as usize * self.width + x as usize]
     }
 
+    /// The 2 × 2 texels from (x, y) to (x + 1, y + 1) that bilinear interpolation reads,
+    /// row by row, each as [`texel`](Self::texel) gives it. For the common wrap modes the
+    /// second column and row follow from the first instead of being wrapped anew:
+    /// repeating takes a remainder, which is a division, and four texels would take eight.
+    pub fn quad(&self, x: i64, y: i64, wrap: WrapMode) -> [Rgb; 4] {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let pair = |x: i64, n: i64| -> Option<(usize, usize)> {
+            match wrap {
+                WrapMode::Repeat => {
+                    let a = x.rem_euclid(n);
+                    Some((a as usize, if a + 1 == n { 0 } else { a as usize + 1 }))
+                }
+                WrapMode::Clamp => {
+                    Some((x.clamp(0, n - 1) as usize, (x + 1).clamp(0, n - 1) as usize))
+                }
+                WrapMode::Black | WrapMode::OctahedralSphere => None,
+            }
+        };
+        match (pair(x, w), pair(y, h)) {
+            (Some((x0, x1)), Some((y0, y1))) => {
+                let row = |y: usize| &self.texels[y * self.width..(y + 1) * self.width];
+                let (r0, r1) = (row(y0), row(y1));
+                [r0[x0], r0[x1], r1[x0], r1[x1]]
+            }
+            _ => [
+                self.texel(x, y, wrap),
+                self.texel(x + 1, y, wrap),
+                self.texel(x, y + 1, wrap),
+                self.texel(x + 1, y + 1, wrap),
+            ],
+        }
+    }
+
     /// Half the size, by 2×2 box averages.
     fn downsample(&self) -> Level {
         let (w, h) = (
@@ -233,5 +266,48 @@ impl ImageCache {
         let map = Arc::new(MipMap::new(read_linear(path, encoding)?));
         self.maps.insert(key, map.clone());
         Ok(map)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 2 × 2 block equals four single reads, in every wrap mode, for images down to
+    /// one texel wide or high and coordinates inside, beside and far outside them.
+    #[test]
+    fn a_quad_is_four_texels() {
+        for (w, h) in [(1, 1), (1, 5), (4, 1), (2, 2), (7, 3), (16, 16)] {
+            let texels = (0..w * h)
+                .map(|i| Rgb::new(i as f32, (i * 7 % 5) as f32, 0.5))
+                .collect();
+            let level = Level::new(w, h, texels);
+            for wrap in [
+                WrapMode::Repeat,
+                WrapMode::Clamp,
+                WrapMode::Black,
+                WrapMode::OctahedralSphere,
+            ] {
+                if wrap == WrapMode::OctahedralSphere && w != h {
+                    continue;
+                }
+                let coords = (-40i64..40).chain([i64::from(i32::MAX), -i64::from(i32::MAX)]);
+                for x in coords.clone() {
+                    for y in coords.clone().step_by(3) {
+                        let single = [
+                            level.texel(x, y, wrap),
+                            level.texel(x + 1, y, wrap),
+                            level.texel(x, y + 1, wrap),
+                            level.texel(x + 1, y + 1, wrap),
+                        ];
+                        assert_eq!(
+                            level.quad(x, y, wrap),
+                            single,
+                            "{w}x{h} {wrap:?} ({x}, {y})"
+                        );
+                    }
+                }
+            }
+        }
     }
 }
