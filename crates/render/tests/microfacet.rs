@@ -61,44 +61,26 @@ fn rel_close(a: f32, b: f32, tol: f32) -> bool {
 }
 
 /// Chi-square of `material.sample` from `wo` against `material.pdf`; each sample's
-/// value and density must also equal `eval_mode` and `pdf` there: to 1 % always, and
-/// to 0.2 % (value) and 0.1 % (density) for all but one sample in 10⁴. Near a
-/// microfacet's critical angle the refracted direction's cosine to the normal goes to
-/// zero, and both carry it as a factor: the sampled normal and the one recovered from
-/// the pair of directions differ by f32 roundings that this factor amplifies to a few
-/// tenths of a per cent. From inside the dielectric that happens about once in 10⁶
-/// samples (worst 3.9e-3 in 2 M at alpha 0.5), whichever seed or sine the sampler uses.
+/// value must also equal `eval_mode` there.
 fn chi2_of(name: &str, material: Material, wo: Vec3, mode: TransportMode, seed: u64) {
-    let loose = std::cell::Cell::new(0u64);
     let report = ChiSquareTest::new(name, Domain::Sphere)
         .samples(SAMPLES)
         .seed(seed)
-        .pdf_tolerance(1e-2)
         .run_with_pdf(
             |u| {
                 let bs = material.sample(wo, u.u1, u.u2, mode)?;
                 let f = material.eval_mode(wo, bs.wi, mode);
                 assert!(!bs.specular, "{name}: a rough lobe is not a delta");
-                let close = |tol| rel_close(bs.f.r, f.r, tol) && rel_close(bs.f.b, f.b, tol);
                 assert!(
-                    close(1e-2),
+                    rel_close(bs.f.r, f.r, 2e-3) && rel_close(bs.f.b, f.b, 2e-3),
                     "{name}: sample f {:?} vs eval {f:?} at {}",
                     bs.f,
                     bs.wi
                 );
-                let pdf_close = rel_close(bs.pdf, material.pdf(wo, bs.wi), 1e-3);
-                if !close(2e-3) || !pdf_close {
-                    loose.set(loose.get() + 1);
-                }
                 Some((bs.wi, bs.pdf))
             },
             |wi| material.pdf(wo, wi),
         );
-    assert!(
-        loose.get() * 10_000 <= SAMPLES,
-        "{name}: {} samples whose value (density) differs from eval's (pdf's) by over 0.2 % (0.1 %)",
-        loose.get()
-    );
     check(&report);
     assert!(
         report.pdf_integral <= 1.0 + 2e-3,
