@@ -24,16 +24,6 @@ impl Divisor {
         }
     }
 
-    pub const fn get(self) -> u32 {
-        self.d
-    }
-
-    /// ⌊n / d⌋.
-    #[inline(always)]
-    pub const fn quotient(self, n: u32) -> u32 {
-        ((self.reciprocal as u128 * n as u128) >> 64) as u32
-    }
-
     /// n mod d.
     #[inline(always)]
     pub const fn remainder(self, n: u32) -> u32 {
@@ -64,7 +54,6 @@ mod tests {
     fn quotients_and_remainders_equal_the_hardware_division() {
         let check = |d: u32, n: u32| {
             let divisor = Divisor::new(d);
-            assert_eq!(divisor.quotient(n), n / d, "{n} / {d}");
             assert_eq!(divisor.remainder(n), n % d, "{n} % {d}");
             assert_eq!(divisor.div_rem(n), (n / d, n % d), "{n} divrem {d}");
         };
