@@ -44,26 +44,13 @@ impl Distribution1D {
             *last = 1.0;
         }
         let pmf = (0..n).map(|i| (cdf[i + 1] - cdf[i]) as f32).collect();
-        let mut d = Distribution1D {
+        let guide = guide_table(&cdf);
+        Distribution1D {
             cdf,
             pmf,
-            guide: Vec::new(),
+            guide,
             total,
-        };
-        if n > 0 {
-            let intervals = n.next_power_of_two();
-            let mut item = 0;
-            d.guide = (0..=intervals)
-                .map(|k| {
-                    let u = k as f64 / intervals as f64;
-                    while item + 1 < n && d.cdf[item + 1] <= u {
-                        item += 1;
-                    }
-                    item as u32
-                })
-                .collect();
         }
-        d
     }
 
     pub fn len(&self) -> usize {
@@ -120,6 +107,26 @@ impl Distribution1D {
         };
         (lo, width as f32, remapped)
     }
+}
+
+/// `guide[k]`: the item that u = k / K falls in (the first whose CDF step ends above
+/// it), for K the item count rounded up to a power of two; empty for no items.
+fn guide_table(cdf: &[f64]) -> Vec<u32> {
+    let n = cdf.len() - 1;
+    if n == 0 {
+        return Vec::new();
+    }
+    let intervals = n.next_power_of_two();
+    let mut item = 0;
+    (0..=intervals)
+        .map(|k| {
+            let u = k as f64 / intervals as f64;
+            while item + 1 < n && cdf[item + 1] <= u {
+                item += 1;
+            }
+            item as u32
+        })
+        .collect()
 }
 
 /// A piecewise-constant density over [0,1]² on a `width` x `height` grid of cells,
