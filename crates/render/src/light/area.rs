@@ -52,13 +52,35 @@ pub enum LightShape {
         patch: BilinearPatch,
         orientation: f32,
     },
-    /// A disk placed by a similarity transform; `scale2` is the area scale factor.
+    /// A disk placed by a similarity transform; `scale2` is the area scale factor. Its
+    /// render-space front normal and area density are the same for every point, so they
+    /// are kept rather than transformed at each sample ([`LightShape::disk`]).
     Disk {
         disk: Disk,
         render_from_object: Transform,
         reverse: bool,
         scale2: f32,
+        normal: Vec3,
+        pdf: f32,
     },
+}
+
+impl LightShape {
+    /// The disk `disk` placed by `render_from_object`, facing the other way with `reverse`.
+    pub fn disk(disk: Disk, render_from_object: Transform, reverse: bool) -> LightShape {
+        let scale2 = similarity_scale2(&render_from_object);
+        let sample = disk.sample_area(Vec2::ZERO);
+        let AreaSample { n: normal, pdf, .. } =
+            to_render(sample, &render_from_object, reverse, scale2);
+        LightShape::Disk {
+            disk,
+            render_from_object,
+            reverse,
+            scale2,
+            normal,
+            pdf,
+        }
+    }
 }
 
 /// The triangles of an emitting mesh and the choice among them by area. One 2D sample
@@ -248,13 +270,20 @@ impl AreaLight {
             LightShape::Disk {
                 disk,
                 render_from_object,
-                reverse,
-                scale2,
+                normal,
+                pdf,
+                ..
             } => {
-                let s = disk.sample_area(u);
+                let q = disk.sample_area(u).p;
+                let (p, p_error) = transform_point_with_error(render_from_object, q, Vec3::ZERO);
                 EmitterSample {
-                    uv: if with_uv { disk.uv(s.p) } else { Vec2::ZERO },
-                    area: to_render(s, render_from_object, *reverse, *scale2),
+                    uv: if with_uv { disk.uv(q) } else { Vec2::ZERO },
+                    area: AreaSample {
+                        p,
+                        p_error,
+                        n: *normal,
+                        pdf: *pdf,
+                    },
                 }
             }
             LightShape::Bilinear { patch, orientation } => {

@@ -786,17 +786,7 @@ fn add_shape(
                 if !is_similarity(&xf) {
                     warnings.push(non_similar_warning(shape));
                 }
-                let scale2 = Mat3::from_mat4(xf.m).determinant().abs().powf(2.0 / 3.0);
-                push_light(
-                    lights,
-                    &a,
-                    LightShape::Disk {
-                        disk,
-                        render_from_object: xf,
-                        reverse: ro,
-                        scale2,
-                    },
-                )
+                push_light(lights, &a, LightShape::disk(disk, xf, ro))
             });
             let i = set.disks.len() as u32;
             set.disks.push(Placed {
