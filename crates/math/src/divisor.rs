@@ -24,6 +24,12 @@ impl Divisor {
         }
     }
 
+    /// d.
+    #[inline(always)]
+    pub const fn get(self) -> u32 {
+        self.d
+    }
+
     /// n mod d.
     #[inline(always)]
     pub const fn remainder(self, n: u32) -> u32 {
