@@ -13,6 +13,7 @@
 //! limit positions (close to the exact limit normal after a few levels).
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::{DVec3, Vec3};
 
@@ -31,42 +32,78 @@ struct Rings {
     boundary: Vec<Vec<u32>>,
 }
 
-/// Edges of a triangle list, each once (smaller index first), with how many triangles
-/// use them and the vertices opposite them.
+/// Edges of a triangle list, each once (smaller index first) and numbered in the order
+/// the triangles first name them, with how many triangles use them, the first two
+/// vertices opposite them (all an interior edge has) and the edges of each triangle.
 struct Edges {
-    index: HashMap<(u32, u32), u32>,
     ends: Vec<(u32, u32)>,
-    opposite: Vec<Vec<u32>>,
+    uses: Vec<u32>,
+    opposite: Vec<[u32; 2]>,
+    /// Edges ab, bc and ca of each triangle abc.
+    of_triangle: Vec<[u32; 3]>,
 }
 
 fn key(a: u32, b: u32) -> (u32, u32) {
     if a < b { (a, b) } else { (b, a) }
 }
 
+/// A hasher for an edge's two vertex indices, packed in one word: std's default
+/// (SipHash, built against adversarial keys) took most of a subdivision level's time.
+#[derive(Default)]
+struct EdgeHasher(u64);
+
+impl Hasher for EdgeHasher {
+    fn finish(&self) -> u64 {
+        radiant_math::hash::mix64(self.0)
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 << 8) ^ b as u64;
+        }
+    }
+
+    fn write_u64(&mut self, v: u64) {
+        self.0 = v;
+    }
+}
+
 impl Edges {
     fn of(indices: &[u32]) -> Edges {
+        let mut index: HashMap<u64, u32, BuildHasherDefault<EdgeHasher>> =
+            HashMap::with_capacity_and_hasher(indices.len(), Default::default());
         let mut e = Edges {
-            index: HashMap::with_capacity(indices.len()),
             ends: Vec::with_capacity(indices.len()),
+            uses: Vec::with_capacity(indices.len()),
             opposite: Vec::with_capacity(indices.len()),
+            of_triangle: Vec::with_capacity(indices.len() / 3),
         };
         for t in indices.chunks_exact(3) {
-            for k in 0..3 {
+            let mut ids = [0u32; 3];
+            for (k, id_out) in ids.iter_mut().enumerate() {
                 let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+                let (lo, hi) = key(a, b);
                 let next = e.ends.len() as u32;
-                let id = *e.index.entry(key(a, b)).or_insert(next);
+                let id = *index.entry((lo as u64) << 32 | hi as u64).or_insert(next);
                 if id == next {
-                    e.ends.push(key(a, b));
-                    e.opposite.push(Vec::new());
+                    e.ends.push((lo, hi));
+                    e.uses.push(0);
+                    e.opposite.push([0; 2]);
                 }
-                e.opposite[id as usize].push(c);
+                let i = id as usize;
+                if let Some(slot) = e.opposite[i].get_mut(e.uses[i] as usize) {
+                    *slot = c;
+                }
+                e.uses[i] += 1;
+                *id_out = id;
             }
+            e.of_triangle.push(ids);
         }
         e
     }
 
     fn is_boundary(&self, id: usize) -> bool {
-        self.opposite[id].len() != 2
+        self.uses[id] != 2
     }
 
     fn rings(&self, vertex_count: usize) -> Rings {
@@ -112,11 +149,10 @@ fn refine(points: &[DVec3], indices: &[u32]) -> (Vec<DVec3>, Vec<u32>) {
             0.375 * (pa + pb) + 0.125 * sum(points, &edges.opposite[id])
         });
     }
-    let odd = |a: u32, b: u32| first_odd + edges.index[&key(a, b)];
     let mut tris = Vec::with_capacity(indices.len() * 4);
-    for t in indices.chunks_exact(3) {
+    for (t, ids) in indices.chunks_exact(3).zip(&edges.of_triangle) {
         let (a, b, c) = (t[0], t[1], t[2]);
-        let (ab, bc, ca) = (odd(a, b), odd(b, c), odd(c, a));
+        let [ab, bc, ca] = ids.map(|id| first_odd + id);
         tris.extend_from_slice(&[a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca]);
     }
     (out, tris)
@@ -279,6 +315,43 @@ mod tests {
             "{}",
             s.positions[1]
         );
+    }
+
+    /// An edge two triangles share gets Loop's interior odd rule; one that a single
+    /// triangle or three triangles use (a fin: not a 2-manifold there) gets the boundary
+    /// midpoint. Each triangle's four children name the odd vertices of its own edges.
+    #[test]
+    fn odd_vertices_follow_how_many_triangles_use_the_edge() {
+        let p = [
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(0.5, 1.0, 0.0),
+            DVec3::new(0.5, -1.0, 0.0),
+            DVec3::new(0.5, 0.0, 1.0),
+        ];
+        let odd_of = |indices: &[u32], a: u32, b: u32| {
+            let (points, tris) = refine(&p, indices);
+            // The child triangle at corner a of the first triangle is (a, ab, ca).
+            let t = &tris[..3];
+            assert_eq!(t[0], indices[0]);
+            let ab = if (indices[0], indices[1]) == (a, b) {
+                t[1]
+            } else {
+                t[2]
+            };
+            points[ab as usize]
+        };
+        // Two triangles on edge 0–1: 3/8 of its ends, 1/8 of vertices 2 and 3.
+        let two = [0, 1, 2, 1, 0, 3];
+        let expected = 0.375 * (p[0] + p[1]) + 0.125 * (p[2] + p[3]);
+        assert!((odd_of(&two, 0, 1) - expected).length() < 1e-15);
+        // A third triangle on the same edge: the midpoint.
+        let three = [0, 1, 2, 1, 0, 3, 0, 1, 4];
+        assert!((odd_of(&three, 0, 1) - 0.5 * (p[0] + p[1])).length() < 1e-15);
+        // Every child names an odd vertex of an edge of its parent: 3 corners + 3 odd.
+        let (points, tris) = refine(&p, &three);
+        assert_eq!(tris.len(), 4 * three.len());
+        assert_eq!(points.len(), p.len() + 7);
     }
 
     #[test]
