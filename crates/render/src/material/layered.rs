@@ -264,8 +264,8 @@ impl Coat {
                 let w_m = w.dot(m);
                 let s = w_m + a_m / etap;
                 let pdf = d.d_visible(a, m) * w_m.abs() / (s * s);
-                let f = rough::dielectric_eval(d, self.eta, a, w, mode);
                 let t = 1.0 - fresnel::dielectric(a_m, self.eta);
+                let f = rough::refracted_value(d, m, a, w, t, etap, mode);
                 (pdf > 0.0 && pdf.is_finite() && f.is_finite()).then(|| Transmission {
                     w,
                     pdf,
