@@ -277,26 +277,47 @@ impl Coat {
         }
     }
 
-    /// Density of [`transmit`](Self::transmit) from `a` producing `b` (rough coat).
-    fn transmit_pdf(&self, a: Vec3, b: Vec3) -> f32 {
+    /// Light leaving the layer through the coat from inside along `a` (pointing down,
+    /// as the BSDF's argument) towards `wi` outside: the coat's value from `a` to `wi`
+    /// (for `Quantity::Density`, its own sampler's density), and the density with
+    /// which [`transmit`](Self::transmit) from `wi` refracts into `a`, for the MIS
+    /// weight. Both refract through the same microfacet, the generalized half vector
+    /// of the pair (Walter et al. 2007, eq. 16), found once; zero for a smooth coat.
+    fn exit_through(&self, a: Vec3, wi: Vec3, q: Quantity) -> (f32, f32) {
         let Some(d) = &self.distribution else {
-            return 0.0;
+            return (0.0, 0.0);
         };
-        if a.z * b.z >= 0.0 {
-            return 0.0;
+        if a.z * wi.z >= 0.0 {
+            // Not a refraction: what the coat reflects, and nothing `transmit` makes.
+            let value = match q {
+                Quantity::Value(mode) => rough::dielectric_eval(d, self.eta, a, wi, mode),
+                Quantity::Density => rough::dielectric_pdf(d, self.eta, a, wi),
+            };
+            return (value, 0.0);
         }
-        let etap = if a.z > 0.0 { self.eta } else { 1.0 / self.eta };
-        // The generalized half vector (Walter et al. 2007, eq. 16), facing +z.
-        let Some(m) = (a + etap * b).try_normalize() else {
-            return 0.0;
+        // Relative indices seen from each side: `wi`'s (for `transmit` from it) and
+        // `a`'s (for the coat's value from it).
+        let etap = if wi.z > 0.0 { self.eta } else { 1.0 / self.eta };
+        let etap_a = if a.z > 0.0 { self.eta } else { 1.0 / self.eta };
+        let Some(m) = (wi + etap * a).try_normalize() else {
+            return (0.0, 0.0);
         };
         let m = if m.z < 0.0 { -m } else { m };
-        let (a_m, b_m) = (a.dot(m), b.dot(m));
-        if a_m * a.z <= 0.0 || b_m * b.z <= 0.0 {
-            return 0.0;
+        let (wi_m, a_m) = (wi.dot(m), a.dot(m));
+        if wi_m * wi.z <= 0.0 || a_m * a.z <= 0.0 {
+            return (0.0, 0.0);
         }
-        let s = b_m + a_m / etap;
-        d.d_visible(a, m) * b_m.abs() / (s * s)
+        let s = a_m + wi_m / etap;
+        let transmit_pdf = d.d_visible(wi, m) * a_m.abs() / (s * s);
+        let t = 1.0 - fresnel::dielectric(a_m, self.eta);
+        let value = match q {
+            Quantity::Value(mode) => rough::refracted_value(d, m, a, wi, t, etap_a, mode),
+            Quantity::Density => {
+                let s_a = wi_m + a_m / etap_a;
+                d.d_visible(a, m) * t * wi_m.abs() / (s_a * s_a)
+            }
+        };
+        (value, transmit_pdf)
     }
 
     /// Reflection off the coat from `a`, the Fresnel choice left out.
@@ -556,12 +577,6 @@ impl Layered {
             let t_out = 1.0 - fresnel::dielectric(exit.w.z, coat.eta);
             t_out * wi.z.abs() / (exit.etap * exit.etap * exit.w.z.abs())
         };
-        let exit_value = |a: Vec3| -> f32 {
-            match q {
-                Quantity::Value(mode) => coat.f(a, wi, mode),
-                Quantity::Density => coat.pdf(a, wi),
-            }
-        };
         // A straight flight between the interfaces: absorbed light is lost to the
         // value, and with a scattering medium the flight without collision is also
         // what `sample` does with that probability.
@@ -617,8 +632,9 @@ impl Layered {
                     w = next;
                     z = zs;
                     if rough_coat && w.z > 0.0 {
-                        let wt = power_heuristic(phase_pdf, coat.transmit_pdf(wi, -w));
-                        sum += beta * (transmittance(to_top, w) * exit_value(-w) * wt);
+                        let (value, transmit_pdf) = coat.exit_through(-w, wi, q);
+                        let wt = power_heuristic(phase_pdf, transmit_pdf);
+                        sum += beta * (transmittance(to_top, w) * value * wt);
                     }
                     continue;
                 }
@@ -650,12 +666,13 @@ impl Layered {
                 }
                 w = next;
                 if rough_coat {
+                    let (value, transmit_pdf) = coat.exit_through(-w, wi, q);
                     let wt = if self.base.is_delta() {
                         1.0
                     } else {
-                        power_heuristic(pdf, coat.transmit_pdf(wi, -w))
+                        power_heuristic(pdf, transmit_pdf)
                     };
-                    sum += beta * (flight(thickness, w) * exit_value(-w) * wt);
+                    sum += beta * (flight(thickness, w) * value * wt);
                 }
             } else {
                 let Some(r) = coat.reflect(-w, u2(rng)) else {
@@ -887,4 +904,70 @@ pub fn coated_conductor(
             distribution: distribution(alpha_u, alpha_v),
         },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use radiant_math::hash::Pcg32;
+
+    /// The exit's two numbers are what the coat's value and density give for the pair
+    /// from `a`, and what its density from `wi` gives without the Fresnel choice, to
+    /// rounding: from both sides, in both quantities and transport modes.
+    #[test]
+    fn the_exit_through_the_coat_is_its_value_and_the_transmit_density() {
+        let mut rng = Pcg32::new(23, 1);
+        let mut direction = || {
+            let z = 2.0 * rng.uniform() - 1.0;
+            let phi = std::f32::consts::TAU * rng.uniform();
+            let s = (1.0 - z * z).max(0.0).sqrt();
+            Vec3::new(s * phi.cos(), s * phi.sin(), z)
+        };
+        let close = |x: f32, y: f32| (x - y).abs() <= 1e-3 * x.abs().max(y.abs()) + 1e-6;
+        let mut refracting = 0;
+        for (alpha_x, alpha_y, eta) in [(0.1, 0.1, 1.5), (0.4, 0.15, 1.33), (0.7, 0.7, 2.0)] {
+            let d = TrowbridgeReitz::new(alpha_x, alpha_y);
+            let coat = Coat {
+                eta,
+                distribution: Some(d),
+            };
+            for _ in 0..4000 {
+                let (a, wi) = (direction(), direction());
+                if a.z.abs() < 0.05 || wi.z.abs() < 0.05 {
+                    continue;
+                }
+                for q in [
+                    Quantity::Value(TransportMode::Radiance),
+                    Quantity::Value(TransportMode::Importance),
+                    Quantity::Density,
+                ] {
+                    let (value, transmit_pdf) = coat.exit_through(a, wi, q);
+                    let expected = match q {
+                        Quantity::Value(mode) => rough::dielectric_eval(&d, eta, a, wi, mode),
+                        Quantity::Density => rough::dielectric_pdf(&d, eta, a, wi),
+                    };
+                    assert!(close(value, expected), "{q:?} {a} {wi}: {value} {expected}");
+                    if a.z * wi.z >= 0.0 {
+                        assert_eq!(transmit_pdf, 0.0);
+                        continue;
+                    }
+                    // The coat's own density from wi, less its choice to refract (1 − F
+                    // at the shared microfacet).
+                    let etap = if wi.z > 0.0 { eta } else { 1.0 / eta };
+                    let m = (wi + etap * a).normalize();
+                    let m = if m.z < 0.0 { -m } else { m };
+                    let refract = 1.0 - fresnel::dielectric(wi.dot(m), eta);
+                    let from_wi = rough::dielectric_pdf(&d, eta, wi, a);
+                    if refract > 1e-3 {
+                        assert!(
+                            close(transmit_pdf * refract, from_wi),
+                            "{a} {wi}: {transmit_pdf} × {refract} against {from_wi}"
+                        );
+                        refracting += (from_wi > 0.0) as u32;
+                    }
+                }
+            }
+        }
+        assert!(refracting > 3000, "{refracting}");
+    }
 }
