@@ -1,7 +1,8 @@
 //! The rough (Trowbridge–Reitz microfacet) conductor and dielectric: sampling against
 //! their pdf by Pearson's chi-square test (`radiant_testkit::chi2`) at several
 //! roughnesses, anisotropic ones included, and incidence angles down to grazing, from
-//! both sides of the dielectric; every sample's value and pdf against `eval` and `pdf`;
+//! both sides of the dielectric; the visible normals themselves in slope space, down
+//! to near-mirror roughness; every sample's value and pdf against `eval` and `pdf`;
 //! reciprocity (with the η² rule of refraction); energy: the directional albedo is at
 //! most 1 and equals a brute-force integral of f |cos|, and a white rough conductor
 //! loses exactly the single-scattering energy that the microfacet integral predicts.
@@ -18,8 +19,8 @@ use std::f64::consts::TAU;
 
 /// Family-wise significance of the file's chi-square tests (Šidák-corrected per test).
 const ALPHA: f64 = 0.01;
-/// Every chi-square test in this file: 4 roughnesses x 3 directions for the conductor,
-/// 4 x 5 for the dielectric.
+/// The BSDFs' chi-square tests: 4 roughnesses x 3 directions for the conductor, 4 x 5
+/// for the dielectric (the visible normals' test counts its own).
 const CHI2_TESTS: u32 = 32;
 const SAMPLES: u64 = 200_000;
 
@@ -412,4 +413,61 @@ fn reflectance_conductor_has_that_reflectance_at_normal_incidence() {
     let r = fr.eval(1.0);
     assert!((r.r - 0.1).abs() < 1e-4 && (r.g - 0.5).abs() < 1e-4 && (r.b - 0.95).abs() < 1e-4);
     assert!(fr.eval(0.05).r > r.r);
+}
+
+/// Visible normals against their density in slope space, where even a lobe of
+/// α = 0.002 spreads over the grid: the point p of the unit square stands for the
+/// normal m = normalize(αx sx, αy sy, 1) of slopes (sx, sy) = tan(π (p − ½)), so that
+/// the density of p is D_w(m) · αx αy cos³θm · π² (1 + sx²)(1 + sy²). Roughnesses from
+/// near-mirror to anisotropic, incidence from normal to grazing and from below.
+#[test]
+fn visible_normals_follow_their_density_in_slope_space() {
+    use std::f64::consts::PI;
+    let alphas = [(0.002, 0.002), (0.01, 0.01), (0.01, 0.3), (0.5, 0.5)];
+    let ws = [
+        direction(0.95, 0.4),
+        direction(0.5, 2.0),
+        direction(0.05, 4.0),
+        -direction(0.7, 5.0),
+    ];
+    let tests = (alphas.len() * ws.len()) as u32;
+    let mut seed = 100;
+    for (ax, ay) in alphas {
+        let d = TrowbridgeReitz::new(ax, ay);
+        let (ax, ay) = (ax as f64, ay as f64);
+        let to_square = |s: f64| (0.5 + s.atan() / PI) as f32;
+        let to_slope = |x: f32| (PI * (x as f64 - 0.5)).tan();
+        for w in ws {
+            seed += 1;
+            let square = Domain::Rectangle {
+                min: Vec2::ZERO,
+                max: Vec2::ONE,
+            };
+            let report = ChiSquareTest::new(format!("visible normals {ax}/{ay} from {w}"), square)
+                .samples(1_000_000)
+                .seed(seed)
+                .resolution(64, 64)
+                .run(
+                    |u| {
+                        let m = d.sample_visible(w, u.u2).as_dvec3();
+                        Some(Vec2::new(
+                            to_square(m.x / (ax * m.z)),
+                            to_square(m.y / (ay * m.z)),
+                        ))
+                    },
+                    |p: Vec2| {
+                        let (sx, sy) = (to_slope(p.x), to_slope(p.y));
+                        if !(sx.is_finite() && sy.is_finite()) {
+                            return 0.0;
+                        }
+                        let v = glam::DVec3::new(ax * sx, ay * sy, 1.0);
+                        let cos = 1.0 / v.length();
+                        let jacobian =
+                            ax * ay * cos.powi(3) * PI * PI * (1.0 + sx * sx) * (1.0 + sy * sy);
+                        d.d_visible(w, (v * cos).as_vec3()) as f64 * jacobian
+                    },
+                );
+            report.check(ALPHA, tests);
+        }
+    }
 }
