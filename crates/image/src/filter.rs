@@ -514,6 +514,45 @@ mod tests {
         }
     }
 
+    /// A drawn offset x inverts the interpolant's distribution: the trapezoids' area
+    /// left of x is u of the whole, to the f32 rounding of x, at every tabulated
+    /// filter's axis, in cells where the profile rises, falls or is negative.
+    #[test]
+    fn a_drawn_offset_inverts_the_interpolants_distribution() {
+        let filters = [
+            Filter::gaussian(Vec2::new(1.5, 2.0), 0.5),
+            Filter::mitchell(Vec2::splat(2.0), 1.0 / 3.0, 1.0 / 3.0),
+            Filter::lanczos_sinc(Vec2::new(4.0, 3.0), 3.0),
+        ];
+        let mut rng = Pcg32::new(17, 4);
+        for f in &filters {
+            for axis in f.tables().unwrap() {
+                let total = axis.cdf[TABLE_SEGMENTS];
+                let r = axis.radius as f64;
+                let h = 2.0 * r / TABLE_SEGMENTS as f64;
+                let peak = axis.node_values.iter().fold(0.0f32, |m, &v| m.max(v)) as f64;
+                for _ in 0..20_000 {
+                    let u = rng.uniform();
+                    let x = axis.sample(u).0 as f64;
+                    let cell = ((x + r) / h)
+                        .floor()
+                        .clamp(0.0, (TABLE_SEGMENTS - 1) as f64);
+                    let i = cell as usize;
+                    let t = (x + r) / h - cell;
+                    let (a, b) = (axis.node_values[i] as f64, axis.node_values[i + 1] as f64);
+                    let left = axis.cdf[i] + h * (a * t + 0.5 * (b - a) * t * t);
+                    // x is an f32: its rounding moves the area by up to peak · ulp(r).
+                    let tolerance = 1e-9 + peak * r * f32::EPSILON as f64 / total;
+                    assert!(
+                        (left / total - u as f64).abs() <= tolerance,
+                        "{f:?}: u {u}, x {x}: area left of x {}",
+                        left / total
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn guide_table_finds_the_same_segment_as_binary_search() {
         let Filter::Gaussian { tables, .. } = Filter::default() else {
