@@ -336,20 +336,24 @@ fn anisotropic_f(material: &str, shape: &str, ray: Ray, towards: Vec3) -> f32 {
 
 /// The lobe is wide along ∂p/∂u and narrow across it: f tilted along u is much larger.
 fn assert_stretched_along(shape: &str, ray: Ray, dpdu: Vec3, across: Vec3) {
-    assert_material_stretched_along(ANISOTROPIC_CONDUCTOR, shape, ray, dpdu, across);
+    assert_material_stretched_along(ANISOTROPIC_CONDUCTOR, shape, ray, dpdu, across, 20.0);
 }
 
+/// f tilted along `dpdu` is at least `min_ratio` times f tilted `across`. A tangent
+/// frame that did not follow ∂p/∂u would turn the ratio to its inverse (or to about 1
+/// for a frame turned by 45°).
 fn assert_material_stretched_along(
     material: &str,
     shape: &str,
     ray: Ray,
     dpdu: Vec3,
     across: Vec3,
+    min_ratio: f32,
 ) {
     let along_u = anisotropic_f(material, shape, ray, dpdu);
     let along_v = anisotropic_f(material, shape, ray, across);
     assert!(
-        along_u > 20.0 * along_v,
+        along_u > min_ratio * along_v,
         "{shape}: f along u {along_u}, along v {along_v}"
     );
 }
@@ -391,14 +395,19 @@ fn coated_anisotropic_roughness_follows_dpdu() {
     let uv_quad = "Shape \"trianglemesh\" \"point3 P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0 ] \
                    \"integer indices\" [ 0 1 2  0 2 3 ] \"point2 uv\" [ 0 1  0 0  1 0  1 1 ]";
     let down = Ray::new(Vec3::new(0.1, 0.2, 1.0), -Vec3::Z);
+    // Under the smooth coat the 20° tilt is 13° inside, where the narrow lobe is less
+    // narrow and the walks' interreflections add to both sides: the ratio tends to 21
+    // (21.0 and 21.3 at 65,535 walks with two constructions of the visible normals),
+    // and one estimate of 256 walks ranged 15.7–23.4. At 4,096 walks (19.7 and 21.0)
+    // the test asks for half the limit.
     let coated_conductor = "Material \"coatedconductor\" \"float interface.roughness\" 0 \
         \"float conductor.uroughness\" 0.5 \"float conductor.vroughness\" 0.05 \
-        \"rgb reflectance\" [ 1 1 1 ] \"bool remaproughness\" false \"integer nsamples\" 256";
-    assert_material_stretched_along(coated_conductor, uv_quad, down, Vec3::Y, Vec3::X);
+        \"rgb reflectance\" [ 1 1 1 ] \"bool remaproughness\" false \"integer nsamples\" 4096";
+    assert_material_stretched_along(coated_conductor, uv_quad, down, Vec3::Y, Vec3::X, 10.0);
     let coated_diffuse = "Material \"coateddiffuse\" \"float uroughness\" 0.5 \
         \"float vroughness\" 0.05 \"rgb reflectance\" [ 0 0 0 ] \"bool remaproughness\" false \
         \"integer nsamples\" 256";
-    assert_material_stretched_along(coated_diffuse, uv_quad, down, Vec3::Y, Vec3::X);
+    assert_material_stretched_along(coated_diffuse, uv_quad, down, Vec3::Y, Vec3::X, 20.0);
 }
 
 /// White furnace: under a uniform environment of radiance 1, objects that absorb
