@@ -910,6 +910,7 @@ pub fn coated_conductor(
 mod tests {
     use super::*;
     use radiant_math::hash::Pcg32;
+    use radiant_math::sampling::uniform_sphere;
 
     /// The exit's two numbers are what the coat's value and density give for the pair
     /// from `a`, and what its density from `wi` gives without the Fresnel choice, to
@@ -917,12 +918,7 @@ mod tests {
     #[test]
     fn the_exit_through_the_coat_is_its_value_and_the_transmit_density() {
         let mut rng = Pcg32::new(23, 1);
-        let mut direction = || {
-            let z = 2.0 * rng.uniform() - 1.0;
-            let phi = std::f32::consts::TAU * rng.uniform();
-            let s = (1.0 - z * z).max(0.0).sqrt();
-            Vec3::new(s * phi.cos(), s * phi.sin(), z)
-        };
+        let mut direction = || uniform_sphere(Vec2::new(rng.uniform(), rng.uniform()));
         let close = |x: f32, y: f32| (x - y).abs() <= 1e-3 * x.abs().max(y.abs()) + 1e-6;
         let mut refracting = 0;
         for (alpha_x, alpha_y, eta) in [(0.1, 0.1, 1.5), (0.4, 0.15, 1.33), (0.7, 0.7, 2.0)] {

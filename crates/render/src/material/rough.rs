@@ -240,6 +240,7 @@ pub(super) fn refracted_value(
 mod tests {
     use super::*;
     use radiant_math::hash::Pcg32;
+    use radiant_math::sampling::uniform_sphere;
 
     /// The value from the sampled microfacet is the value `dielectric_eval` finds from
     /// the pair of directions alone, from either side and in both transport modes, to
@@ -252,10 +253,7 @@ mod tests {
             let d = TrowbridgeReitz::new(alpha_x, alpha_y);
             for eta in [1.33f32, 1.5, 2.4] {
                 for _ in 0..2000 {
-                    let z = 2.0 * rng.uniform() - 1.0;
-                    let phi = std::f32::consts::TAU * rng.uniform();
-                    let s = (1.0 - z * z).max(0.0).sqrt();
-                    let wo = Vec3::new(s * phi.cos(), s * phi.sin(), z);
+                    let wo = uniform_sphere(Vec2::new(rng.uniform(), rng.uniform()));
                     if wo.z.abs() < 0.05 {
                         continue;
                     }
