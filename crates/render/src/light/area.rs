@@ -53,12 +53,12 @@ pub enum LightShape {
         orientation: f32,
     },
     /// A disk placed by a similarity transform; `scale2` is the area scale factor. Its
-    /// render-space front normal and area density are the same for every point, so they
-    /// are kept rather than transformed at each sample ([`LightShape::disk`]).
+    /// render-space front normal (reversed where the shape says so) and area density
+    /// are the same for every point, so they are kept rather than transformed at each
+    /// sample ([`LightShape::disk`]).
     Disk {
         disk: Disk,
         render_from_object: Transform,
-        reverse: bool,
         scale2: f32,
         normal: Vec3,
         pdf: f32,
@@ -75,7 +75,6 @@ impl LightShape {
         LightShape::Disk {
             disk,
             render_from_object,
-            reverse,
             scale2,
             normal,
             pdf,

@@ -410,16 +410,14 @@ fn light_bounds(light: &Light, scene: SceneSphere) -> Option<LightBounds> {
                 LightShape::Disk {
                     disk,
                     render_from_object,
-                    reverse,
+                    normal,
                     ..
                 } => {
                     let center = render_from_object.point(Vec3::new(0.0, 0.0, disk.height));
                     let r = disk.radius * similarity_scale(render_from_object);
-                    let n = render_from_object.normal(Vec3::Z);
-                    let n = if *reverse { -n } else { n };
                     (
                         Aabb::new(center - Vec3::splat(r), center + Vec3::splat(r)),
-                        Cone::around(n),
+                        Cone::around(*normal),
                     )
                 }
                 LightShape::Bilinear { patch, .. } => (
